@@ -1,0 +1,27 @@
+# The two commands a newcomer needs: `make run` and `make test`. Both set up first if needed.
+SHELL := /bin/bash
+ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
+ENV := $(ROOT)/tools/rosenv.sh
+
+.PHONY: setup run test test-slow bench unit clean
+
+setup:
+	@bash $(ROOT)/tools/setup.sh
+
+run: setup
+	@bash $(ENV) bash $(ROOT)/tools/run.sh
+
+test: setup
+	@bash $(ENV) python3 $(ROOT)/tools/run_tests.py
+
+test-slow: setup
+	@bash $(ENV) python3 $(ROOT)/tools/run_tests.py --slow
+
+unit: setup
+	@bash $(ENV) python3 -m pytest -q $(ROOT)/tests/unit
+
+bench: setup
+	@bash $(ENV) python3 $(ROOT)/tools/bench.py
+
+clean:
+	rm -rf $(ROOT)/catkin_ws/build $(ROOT)/catkin_ws/devel $(ROOT)/catkin_ws/src $(ROOT)/test-results

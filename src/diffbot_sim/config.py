@@ -1,0 +1,245 @@
+"""One validated configuration for the simulator, built once at start-up.
+
+Pure. Values come from three places, later ones winning: the defaults below (the only place defaults live),
+the model's ``<gazebo><plugin>`` tags (read by :mod:`diffbot_sim.plugins`), and the node's private ROS
+parameters. Every bad value raises ``ConfigError`` naming the parameter (``~time_step``) or the tag and the
+plugin element it stands in; a model that contradicts itself raises ``ModelError``.
+"""
+import math
+from dataclasses import asdict, dataclass, field, fields
+from typing import List, Optional
+
+from .errors import ConfigError, ModelError
+
+#: Wheel speed cap [rad/s] when neither ``~max_wheel_velocity`` nor the URDF ``<limit velocity>`` gives one:
+#: keeps a 1e308 command from reaching the physics as an absurd motor target.
+FALLBACK_MAX_WHEEL_VELOCITY = 100.0
+
+
+@dataclass
+class SimConfig:
+    """Simulator-wide settings (private parameters of ``bullet_sim``). Units in the field comments."""
+
+    model: str = ""  # path of a .urdf or .urdf.xacro; empty: the robot_description parameter
+    model_args: str = ""  # xacro arguments, "name:=value name2:=value2"
+    gui: bool = False
+    time_step: float = 1.0 / 240.0  # s; measured: the fidelity targets hold at it (README)
+    real_time: bool = True  # pace sim time to the wall clock; false: as fast as possible
+    real_time_factor: float = 1.0  # sim seconds per wall second when real_time
+    clock_rate: float = 100.0  # Hz of /clock, in sim time
+    cmd_vel_timeout: float = 0.0  # s; 0 holds the last command (Gazebo); > 0 brakes on stale commands
+    max_wheel_velocity: float = 0.0  # rad/s; 0: the URDF <limit velocity>, else FALLBACK_MAX_WHEEL_VELOCITY
+    gravity: float = -9.81  # m/s^2 along z
+    x: float = 0.0  # m, spawn pose in the world
+    y: float = 0.0
+    z: float = 0.0
+    yaw: float = 0.0  # rad
+    debug_cmd_applied: bool = False  # publish ~debug/cmd_applied (wall time a command reached the motors)
+
+
+@dataclass
+class DriveConfig:
+    """The diff drive, as gazebo_ros_diff_drive defines it (ROS 1 defaults), after tags and parameters."""
+
+    left_joints: List[str] = field(default_factory=lambda: ["left_joint"])
+    right_joints: List[str] = field(default_factory=lambda: ["right_joint"])
+    wheel_separation: Optional[float] = None  # m; None: from the URDF wheel joint origins
+    wheel_diameter: Optional[float] = None  # m; None: from the URDF wheel collision (cylinder/sphere)
+    max_wheel_torque: float = 5.0  # N·m per wheel joint
+    max_wheel_acceleration: float = 0.0  # m/s^2 at the wheel rim; 0: no limit
+    update_rate: float = 100.0  # Hz, in sim time; 0: every physics step
+    command_topic: str = "cmd_vel"
+    odometry_topic: str = "odom"
+    odometry_frame: str = "odom"
+    robot_base_frame: str = "base_footprint"
+    odometry_source: str = "world"  # world (physics pose) or encoder (wheel joint angles)
+    publish_odom: bool = True
+    publish_odom_tf: bool = True
+    publish_wheel_joint_state: bool = False
+    namespace: Optional[str] = None  # None: the node's namespace
+    covariance_x: float = 1e-5  # m^2, pose and twist diagonals
+    covariance_y: float = 1e-5
+    covariance_yaw: float = 1e-3  # rad^2
+
+    @property
+    def wheel_radius(self):
+        return self.wheel_diameter / 2.0
+
+
+#: The ROS 2 plugin publishes nothing unless asked (its publish_odom / publish_odom_tf default false).
+ROS2_DRIVE_DEFAULTS = {"publish_odom": False, "publish_odom_tf": False}
+
+
+@dataclass
+class JointStateConfig:
+    joints: List[str] = field(default_factory=list)
+    update_rate: float = 100.0  # Hz, in sim time
+    topic: str = "joint_states"
+    namespace: Optional[str] = None
+
+
+# ---------------------------------------------------------------------------------------------- builders
+
+def sim_config(params):
+    """Build SimConfig from the node's private parameters (a dict, as ``rospy.get_param('~')``)."""
+    cfg = SimConfig()
+    known = {f.name for f in fields(SimConfig)}
+    for key, value in params.items():
+        if key in known:
+            setattr(cfg, key, value)
+    name = lambda k: f"~{k}"  # noqa: E731
+    cfg.model = _string(name("model"), cfg.model, allow_empty=True)
+    cfg.model_args = _string(name("model_args"), cfg.model_args, allow_empty=True)
+    for key in ("gui", "real_time", "debug_cmd_applied"):
+        setattr(cfg, key, _bool(name(key), getattr(cfg, key)))
+    cfg.time_step = _number(name("time_step"), cfg.time_step, low=1e-5, high=0.05)
+    cfg.real_time_factor = _number(name("real_time_factor"), cfg.real_time_factor, low=1e-3)
+    cfg.clock_rate = _number(name("clock_rate"), cfg.clock_rate, low=1e-3)
+    cfg.cmd_vel_timeout = _number(name("cmd_vel_timeout"), cfg.cmd_vel_timeout, low=0.0)
+    cfg.max_wheel_velocity = _number(name("max_wheel_velocity"), cfg.max_wheel_velocity, low=0.0)
+    for key in ("gravity", "x", "y", "z", "yaw"):
+        setattr(cfg, key, _number(name(key), getattr(cfg, key)))
+    return cfg
+
+
+def drive_config(model, block, params):
+    """Merge defaults, the diff-drive plugin block (may be None) and private params into a DriveConfig.
+
+    Wheel separation and diameter missing from both are taken from the URDF. Returns None when neither the
+    model nor the parameters describe a drive.
+
+    Raises:
+        ConfigError: a value of the wrong type or range. ModelError: a wheel joint the model lacks, a drive
+            wheel whose transmission is not a velocity interface, a wheel without a usable radius.
+    """
+    given = {k: v for k, v in params.items() if k in {f.name for f in fields(DriveConfig)}}
+    if block is None and "left_joints" not in given:
+        return None
+    cfg = DriveConfig()
+    if block is not None and block.dialect == "ros2":
+        for key, value in ROS2_DRIVE_DEFAULTS.items():
+            setattr(cfg, key, value)
+    sources = []
+    if block is not None:
+        sources.append((block.values, lambda k: f"<{k}> of {block.path}"))
+    sources.append((given, lambda k: f"~{k}"))
+    for values, label in sources:
+        for key, value in values.items():
+            setattr(cfg, key, _drive_value(key, value, label(key)))
+    referrer = block.path if block is not None else "~left_joints"
+    if not cfg.left_joints or not cfg.right_joints or len(cfg.left_joints) != len(cfg.right_joints):
+        raise ConfigError("left_joints/right_joints", (cfg.left_joints, cfg.right_joints),
+                          "the same non-zero number of left and right wheel joints")
+    for jname in cfg.left_joints + cfg.right_joints:
+        joint = model.joint(jname, referrer)
+        if not joint.movable:
+            raise ModelError(f"drive wheel joint '{jname}' is {joint.type}, not a revolute/continuous joint",
+                             model.source, f"/robot/joint[@name='{jname}']")
+        for trans in model.transmissions:
+            if trans.joint == jname and trans.interface != "VelocityJointInterface":
+                raise ModelError(f"drive wheel joint '{jname}' declares {trans.interface}; the diff drive "
+                                 "needs VelocityJointInterface", model.source,
+                                 f"/robot/transmission[@name='{trans.name}']/joint[@name='{jname}']")
+    if cfg.wheel_separation is None:
+        cfg.wheel_separation = model.wheel_separation(cfg.left_joints[0], cfg.right_joints[0], referrer)
+    if cfg.wheel_diameter is None:
+        cfg.wheel_diameter = 2.0 * model.wheel_radius(cfg.left_joints[0], referrer)
+    if cfg.wheel_separation <= 0:
+        raise ModelError(f"wheel separation must be > 0, got {cfg.wheel_separation}", model.source, referrer)
+    return cfg
+
+
+def joint_state_config(model, block, drive):
+    """JointStateConfig from the joint-state plugin and, when the drive says so, its wheels.
+
+    Raises:
+        ModelError: a listed joint the model lacks (gazebo logs ROS_FATAL; we refuse to start).
+    """
+    cfg = JointStateConfig()
+    if block is not None:
+        for key, value in block.values.items():
+            label = f"<{key}> of {block.path}"
+            if key == "joints":
+                cfg.joints = list(value)
+            elif key == "update_rate":
+                cfg.update_rate = _number(label, value, low=0.0)
+            elif key in ("topic", "namespace"):
+                setattr(cfg, key, _string(label, value, allow_empty=key == "namespace"))
+        for jname in cfg.joints:
+            model.joint(jname, block.path)
+    if drive is not None and drive.publish_wheel_joint_state:
+        for jname in drive.left_joints + drive.right_joints:
+            if jname not in cfg.joints:
+                cfg.joints.append(jname)
+        if block is None:
+            cfg.update_rate = drive.update_rate
+            cfg.namespace = drive.namespace
+    return cfg if cfg.joints else None
+
+
+def as_params(cfg):
+    """The effective configuration as a flat dict of ROS-parameter-friendly values (None dropped)."""
+    return {k: v for k, v in asdict(cfg).items() if v is not None}
+
+
+# -------------------------------------------------------------------------------------------- validators
+
+def _drive_value(key, value, label):
+    if key in ("left_joints", "right_joints"):
+        names = [value] if isinstance(value, str) else value
+        if not isinstance(names, (list, tuple)) or not all(isinstance(n, str) and n for n in names):
+            raise ConfigError(label, value, "a joint name or a list of joint names")
+        out = []
+        for item in names:
+            out.extend(part for part in item.replace(",", " ").split() if part)
+        return out
+    if key in ("wheel_separation", "wheel_diameter"):
+        return _number(label, value, low=0.0, low_open=True)
+    if key in ("max_wheel_torque", "max_wheel_acceleration", "update_rate"):
+        return _number(label, value, low=0.0)
+    if key in ("covariance_x", "covariance_y", "covariance_yaw"):
+        return _number(label, value, low=0.0)
+    if key in ("publish_odom", "publish_odom_tf", "publish_wheel_joint_state"):
+        return _bool(label, value)
+    if key == "odometry_source":
+        text = str(value).strip().lower()
+        mapped = {"0": "encoder", "1": "world", "encoder": "encoder", "world": "world"}.get(text)
+        if mapped is None:
+            raise ConfigError(label, value, "world or encoder (ROS 2: 1 or 0)")
+        return mapped
+    if key == "namespace":
+        return _string(label, value, allow_empty=True)
+    return _string(label, value)
+
+
+def _number(name, value, low=None, high=None, low_open=False):
+    if isinstance(value, bool):
+        raise ConfigError(name, value, "a number")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ConfigError(name, value, "a number") from None
+    if not math.isfinite(number):
+        raise ConfigError(name, value, "a finite number")
+    if low is not None and (number < low or (low_open and number == low)):
+        raise ConfigError(name, value, f"a number {'>' if low_open else '>='} {low:g}")
+    if high is not None and number > high:
+        raise ConfigError(name, value, f"a number <= {high:g}")
+    return number
+
+
+def _bool(name, value):
+    if isinstance(value, bool):
+        return value
+    text = str(value).strip().lower()
+    if text in ("true", "1"):
+        return True
+    if text in ("false", "0"):
+        return False
+    raise ConfigError(name, value, "true or false")
+
+
+def _string(name, value, allow_empty=False):
+    if not isinstance(value, str) or (not allow_empty and not value.strip()):
+        raise ConfigError(name, value, "a non-empty string" if not allow_empty else "a string")
+    return value.strip()

@@ -1,0 +1,80 @@
+"""Turn a model file (URDF or xacro) into URDF text, and resolve mesh URIs for PyBullet.
+
+xacro 1.13.3 (the ROS 1 one) runs in-process through its API, so ``$(find pkg)`` works through rospkg and
+``$(arg name)`` through the mappings we pass; nothing is shelled out. xacro and rospkg are imported
+lazily so the rest of the package stays importable without them.
+"""
+import os
+import xml.etree.ElementTree as ET
+
+from .errors import ModelError
+
+
+def parse_args(text):
+    """``"a:=1 b:=x"`` -> {"a": "1", "b": "x"} (xacro's command-line mapping syntax)."""
+    mappings = {}
+    for token in text.split():
+        name, sep, value = token.partition(":=")
+        if not sep or not name:
+            raise ModelError(f"xacro argument '{token}' is not name:=value", "~model_args")
+        mappings[name] = value
+    return mappings
+
+
+def load_file(path, args=None):
+    """Read ``path``; run xacro on it when it is a .xacro file. Returns URDF text.
+
+    Raises:
+        ModelError: the file is missing or unreadable, or xacro fails (the message names the file).
+    """
+    if not os.path.isfile(path):
+        raise ModelError("no such file", path)
+    if not path.endswith(".xacro"):
+        try:
+            with open(path, encoding="utf-8") as handle:
+                return handle.read()
+        except (OSError, UnicodeDecodeError) as err:
+            raise ModelError(f"cannot read ({err})", path) from None
+    import xacro  # lazy: only xacro files need it
+
+    try:
+        doc = xacro.process_file(path, mappings=dict(args or {}))
+        return doc.toprettyxml(indent="  ")
+    except Exception as err:  # noqa: BLE001 - xacro raises XacroException, ExpatError, IOError, NameError...
+        detail = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise ModelError(f"xacro failed: {detail}", path) from None
+    finally:
+        # xacro 1.13 keeps processing state in module globals; leave them clean for the next call.
+        for name in ("filestack", "macrostack"):
+            if hasattr(xacro, name):
+                setattr(xacro, name, None if name == "filestack" else [])
+        if hasattr(xacro, "all_includes"):
+            xacro.all_includes = []
+
+
+def resolve_uri(uri, source):
+    """``package://pkg/path`` (via rospkg) or ``file://path`` -> an absolute file path PyBullet can open."""
+    if uri.startswith("package://"):
+        package, _, rest = uri[len("package://"):].partition("/")
+        import rospkg  # lazy
+
+        try:
+            return os.path.join(rospkg.RosPack().get_path(package), rest)
+        except rospkg.ResourceNotFound:
+            raise ModelError(f"mesh '{uri}': package '{package}' not found (is it on ROS_PACKAGE_PATH?)",
+                             source) from None
+    if uri.startswith("file://"):
+        return uri[len("file://"):]
+    return uri
+
+
+def resolve_meshes(text, source):
+    """Rewrite every ``<mesh filename=...>`` with a package:// or file:// URI to a plain path."""
+    if "package://" not in text and "file://" not in text:
+        return text
+    root = ET.fromstring(text)
+    for mesh in root.iter("mesh"):
+        uri = mesh.get("filename", "")
+        if uri.startswith(("package://", "file://")):
+            mesh.set("filename", resolve_uri(uri, source))
+    return ET.tostring(root, encoding="unicode")

@@ -1,0 +1,306 @@
+"""The robot description as plain data: links, joints, transmissions and ``<gazebo>`` blocks.
+
+Pure (no rospy, no PyBullet). We parse the URDF with ElementTree rather than urdf_parser_py because we need
+what that library drops: ``mechanicalReduction`` (its ``Actuator`` discards it), every ``<gazebo>`` element
+(plugins and per-link surface tags), and an element path for every error. Errors are ``ModelError`` naming
+the source and the element, e.g. ``/robot/transmission[@name='left_trans']/joint[@name='nope']``.
+"""
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Tuple
+
+from .errors import ModelError
+
+#: Joint interfaces a transmission may declare (ros_control's, without the ``hardware_interface/`` prefix).
+JOINT_INTERFACES = ("VelocityJointInterface", "EffortJointInterface", "PositionJointInterface")
+
+Vec3 = Tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """A collision shape: ``kind`` is cylinder, sphere, box or mesh; sizes in m."""
+
+    kind: str
+    radius: Optional[float] = None
+    length: Optional[float] = None
+
+
+@dataclass
+class Link:
+    name: str
+    mass: Optional[float]  # None: the link has no <inertial> (e.g. base_footprint)
+    collisions: List[Geometry] = field(default_factory=list)
+
+
+@dataclass
+class Joint:
+    name: str
+    type: str
+    parent: str
+    child: str
+    xyz: Vec3 = (0.0, 0.0, 0.0)
+    rpy: Vec3 = (0.0, 0.0, 0.0)
+    axis: Vec3 = (1.0, 0.0, 0.0)
+    effort_limit: Optional[float] = None  # N·m (or N); None when the URDF gives no <limit effort>
+    velocity_limit: Optional[float] = None  # rad/s (or m/s)
+
+    @property
+    def movable(self):
+        return self.type not in ("fixed", "floating", "planar")
+
+
+@dataclass
+class Transmission:
+    """One ros_control SimpleTransmission: actuator <-> joint with reduction n.
+
+    joint velocity = actuator velocity / n; joint effort = n * actuator effort;
+    joint position = actuator position / n + offset (ros_control's simple_transmission.h).
+    """
+
+    name: str
+    type: str
+    joint: str
+    interface: str  # one of JOINT_INTERFACES
+    actuator: Optional[str] = None
+    reduction: float = 1.0
+    offset: float = 0.0
+
+    def actuator_to_joint_velocity(self, velocity):
+        return velocity / self.reduction
+
+    def joint_to_actuator_velocity(self, velocity):
+        return velocity * self.reduction
+
+    def actuator_to_joint_effort(self, effort):
+        return effort * self.reduction
+
+    def joint_to_actuator_effort(self, effort):
+        return effort / self.reduction
+
+    def actuator_to_joint_position(self, position):
+        return position / self.reduction + self.offset
+
+    def joint_to_actuator_position(self, position):
+        return (position - self.offset) * self.reduction
+
+
+@dataclass
+class GazeboBlock:
+    """A ``<gazebo>`` element; ``reference`` is the link (or joint) it applies to, None for the robot."""
+
+    reference: Optional[str]
+    element: ET.Element
+    path: str
+
+
+@dataclass
+class RobotModel:
+    name: str
+    source: str
+    links: Dict[str, Link]
+    joints: Dict[str, Joint]
+    transmissions: List[Transmission]
+    gazebo: List[GazeboBlock]
+    root: str
+
+    def joint(self, name, referrer):
+        """Return joint ``name`` or raise ModelError naming ``referrer`` (the element that asked for it)."""
+        if name not in self.joints:
+            known = ", ".join(sorted(j for j, v in self.joints.items() if v.movable)) or "none"
+            raise ModelError(f"names joint '{name}', which the model does not have (movable joints: {known})",
+                             self.source, referrer)
+        return self.joints[name]
+
+    def total_mass(self):
+        """Sum of the URDF's <inertial> masses [kg]."""
+        return sum(link.mass or 0.0 for link in self.links.values())
+
+    def surface(self, link):
+        """Gazebo surface tags (mu1, mu2, kp, kd, ...) given in ``<gazebo reference=link>``, as floats."""
+        values = {}
+        for block in self.gazebo:
+            if block.reference != link:
+                continue
+            for child in block.element:
+                if child.tag in ("mu1", "mu2", "kp", "kd", "minDepth", "maxVel"):
+                    values[child.tag] = _float(child.text, self.source, f"{block.path}/{child.tag}")
+        return values
+
+    def wheel_radius(self, joint_name, referrer):
+        """Radius [m] of the wheel driven by ``joint_name``: its child link's cylinder or sphere collision.
+
+        As diff_drive_controller does; any other shape cannot give a radius.
+        """
+        joint = self.joint(joint_name, referrer)
+        link = self.links[joint.child]
+        for geom in link.collisions:
+            if geom.kind in ("cylinder", "sphere"):
+                if not geom.radius or geom.radius <= 0 or not math.isfinite(geom.radius):
+                    raise ModelError(f"wheel radius must be > 0, got {geom.radius}", self.source,
+                                     f"/robot/link[@name='{link.name}']/collision/geometry/{geom.kind}")
+                return geom.radius
+        raise ModelError("has no cylinder or sphere collision to take a wheel radius from "
+                         "(add one, or give the plugin's wheel diameter)",
+                         self.source, f"/robot/link[@name='{link.name}']")
+
+    def wheel_separation(self, left, right, referrer):
+        """Distance [m] between the two wheel joints' origins, as diff_drive_controller computes it."""
+        a, b = self.joint(left, referrer).xyz, self.joint(right, referrer).xyz
+        return math.dist(a, b)
+
+
+def parse_urdf(text, source="robot_description"):
+    """Parse URDF XML text into a RobotModel.
+
+    Raises:
+        ModelError: malformed XML, a missing name, a joint whose links do not exist, a transmission naming a
+            missing joint or an unknown interface, a non-positive mechanicalReduction.
+    """
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as err:
+        raise ModelError(f"malformed XML ({err})", source) from None
+    if root.tag != "robot":
+        raise ModelError(f"root element is <{root.tag}>, expected <robot>", source, f"/{root.tag}")
+    name = root.get("name", "")
+
+    links = {}
+    for el in root.findall("link"):
+        lname = _required(el, "name", source, "/robot/link")
+        path = f"/robot/link[@name='{lname}']"
+        mass = None
+        inertial = el.find("inertial")
+        if inertial is not None:
+            mass_el = inertial.find("mass")
+            if mass_el is None:
+                raise ModelError("<inertial> has no <mass>", source, f"{path}/inertial")
+            mass = _float(mass_el.get("value"), source, f"{path}/inertial/mass[@value]")
+            if mass < 0:
+                raise ModelError(f"mass must be >= 0, got {mass}", source, f"{path}/inertial/mass[@value]")
+        collisions = [_geometry(c.find("geometry"), source, f"{path}/collision") for c in el.findall("collision")]
+        links[lname] = Link(lname, mass, [g for g in collisions if g is not None])
+    if not links:
+        raise ModelError("has no <link>", source, "/robot")
+
+    joints = {}
+    for el in root.findall("joint"):
+        jname = _required(el, "name", source, "/robot/joint")
+        path = f"/robot/joint[@name='{jname}']"
+        jtype = _required(el, "type", source, path)
+        parent = _link_ref(el, "parent", links, source, path)
+        child = _link_ref(el, "child", links, source, path)
+        origin = el.find("origin")
+        xyz = _vec(origin.get("xyz") if origin is not None else None, source, f"{path}/origin[@xyz]")
+        rpy = _vec(origin.get("rpy") if origin is not None else None, source, f"{path}/origin[@rpy]")
+        axis_el = el.find("axis")
+        axis = _vec(axis_el.get("xyz") if axis_el is not None else None, source, f"{path}/axis[@xyz]",
+                    default=(1.0, 0.0, 0.0))
+        limit = el.find("limit")
+        effort = velocity = None
+        if limit is not None:
+            if limit.get("effort") is not None:
+                effort = _float(limit.get("effort"), source, f"{path}/limit[@effort]")
+            if limit.get("velocity") is not None:
+                velocity = _float(limit.get("velocity"), source, f"{path}/limit[@velocity]")
+        joints[jname] = Joint(jname, jtype, parent, child, xyz, rpy, axis, effort, velocity)
+
+    children = {j.child for j in joints.values()}
+    roots = [l for l in links if l not in children]
+    if len(roots) != 1:
+        raise ModelError(f"must have exactly one root link, found {len(roots)}: {', '.join(roots)}", source, "/robot")
+
+    model = RobotModel(name, source, links, joints, [], [], roots[0])
+    for index, el in enumerate(root.findall("transmission"), start=1):
+        model.transmissions.append(_transmission(el, index, model))
+    for index, el in enumerate(root.findall("gazebo"), start=1):
+        ref = el.get("reference")
+        path = f"/robot/gazebo[@reference='{ref}']" if ref else f"/robot/gazebo[{index}]"
+        model.gazebo.append(GazeboBlock(ref, el, path))
+    return model
+
+
+def _transmission(el, index, model):
+    source = model.source
+    tname = el.get("name")
+    path = f"/robot/transmission[@name='{tname}']" if tname else f"/robot/transmission[{index}]"
+    type_el = el.find("type")
+    ttype = (type_el.text or "").strip() if type_el is not None else el.get("type", "")
+    if not ttype:
+        raise ModelError("has no <type> (e.g. transmission_interface/SimpleTransmission)", source, path)
+    joint_els = el.findall("joint")
+    if len(joint_els) != 1:
+        raise ModelError(f"must name exactly one <joint>, found {len(joint_els)}", source, path)
+    jname = _required(joint_els[0], "name", source, f"{path}/joint")
+    jpath = f"{path}/joint[@name='{jname}']"
+    model.joint(jname, jpath)
+    actuator = el.find("actuator")
+    interfaces = [i.text for i in joint_els[0].findall("hardwareInterface")]
+    if not interfaces and actuator is not None:  # deprecated: interface only on the actuator
+        interfaces = [i.text for i in actuator.findall("hardwareInterface")]
+    if not interfaces:
+        raise ModelError("has no <hardwareInterface>", source, jpath)
+    interface = (interfaces[0] or "").strip().split("/")[-1]
+    if interface not in JOINT_INTERFACES:
+        raise ModelError(f"hardware interface '{interfaces[0]}' is not one of {', '.join(JOINT_INTERFACES)}",
+                         source, f"{jpath}/hardwareInterface")
+    reduction, offset = 1.0, 0.0
+    red_el = actuator.find("mechanicalReduction") if actuator is not None else el.find("mechanicalReduction")
+    if red_el is not None:
+        reduction = _float(red_el.text, source, f"{path}/actuator/mechanicalReduction")
+        if reduction == 0:
+            raise ModelError("mechanicalReduction must not be 0", source, f"{path}/actuator/mechanicalReduction")
+    off_el = joint_els[0].find("offset")
+    if off_el is not None:
+        offset = _float(off_el.text, source, f"{jpath}/offset")
+    return Transmission(tname or f"transmission_{index}", ttype, jname, interface,
+                        actuator.get("name") if actuator is not None else None, reduction, offset)
+
+
+def _required(el, attr, source, path):
+    value = el.get(attr)
+    if not value:
+        raise ModelError(f"missing attribute '{attr}'", source, path)
+    return value
+
+
+def _link_ref(el, tag, links, source, path):
+    ref = el.find(tag)
+    if ref is None or not ref.get("link"):
+        raise ModelError(f"missing <{tag} link=...>", source, path)
+    if ref.get("link") not in links:
+        raise ModelError(f"names link '{ref.get('link')}', which the model does not have", source, f"{path}/{tag}")
+    return ref.get("link")
+
+
+def _float(text, source, path):
+    try:
+        value = float(str(text).strip())
+    except (TypeError, ValueError):
+        raise ModelError(f"'{text}' is not a number", source, path) from None
+    if not math.isfinite(value):
+        raise ModelError(f"'{text}' is not a finite number", source, path)
+    return value
+
+
+def _vec(text, source, path, default=(0.0, 0.0, 0.0)):
+    if text is None:
+        return default
+    parts = text.split()
+    if len(parts) != 3:
+        raise ModelError(f"'{text}' is not three numbers", source, path)
+    return tuple(_float(p, source, path) for p in parts)
+
+
+def _geometry(geom, source, path):
+    if geom is None or len(geom) == 0:
+        return None
+    shape = geom[0]
+    gpath = f"{path}/geometry/{shape.tag}"
+    if shape.tag == "cylinder":
+        return Geometry("cylinder", _float(shape.get("radius"), source, f"{gpath}[@radius]"),
+                        _float(shape.get("length"), source, f"{gpath}[@length]"))
+    if shape.tag == "sphere":
+        return Geometry("sphere", _float(shape.get("radius"), source, f"{gpath}[@radius]"))
+    return Geometry(shape.tag)

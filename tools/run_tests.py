@@ -1,0 +1,125 @@
+#!/usr/bin/env python3
+"""Runs every test of the project and ends with one line `N passed, N failed`.
+
+pytest (unit tests, no master) runs first; then each rostest suite in tests/integration/*.test, two at a time
+(each rostest starts its own master on a free port). rostest is judged by its exit status and its result
+XML files, never by its console output, which says OK even when a test node crashed.
+Suites whose file name starts with `slow_` run only with --slow (`make test-slow`).
+"""
+import argparse
+import concurrent.futures
+import glob
+import os
+import shutil
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+RESULTS = os.path.join(ROOT, "test-results")
+
+
+def count_junit(paths):
+    """Return (passed, failed, skipped, failed_names) summed over JUnit XML files."""
+    passed = failed = skipped = 0
+    names = []
+    for path in paths:
+        try:
+            root = ET.parse(path).getroot()
+        except ET.ParseError as err:
+            failed += 1
+            names.append(f"{os.path.basename(path)}: unreadable result file ({err})")
+            continue
+        for case in root.iter("testcase"):
+            name = f"{case.get('classname', '')}.{case.get('name', '')}"
+            if case.find("failure") is not None or case.find("error") is not None:
+                failed += 1
+                names.append(name)
+            elif case.find("skipped") is not None:
+                skipped += 1
+            else:
+                passed += 1
+    return passed, failed, skipped, names
+
+
+def run_pytest(slow):
+    out = os.path.join(RESULTS, "pytest.xml")
+    cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", f"--junitxml={out}",
+           os.path.join(ROOT, "tests", "unit")]
+    if not slow:
+        cmd += ["-m", "not slow"]
+    started = time.monotonic()
+    proc = subprocess.run(cmd, cwd=ROOT)
+    passed, failed, skipped, names = count_junit([out]) if os.path.exists(out) else (0, 0, 0, [])
+    if proc.returncode not in (0, 5) and failed == 0:
+        failed, names = 1, [f"pytest exited {proc.returncode}"]
+    print(f"[tests] pytest: {passed} passed, {failed} failed, {skipped} skipped "
+          f"({time.monotonic() - started:.0f} s)", flush=True)
+    return passed, failed, skipped, names
+
+
+def run_rostest(test_file):
+    name = os.path.splitext(os.path.basename(test_file))[0]
+    base = os.path.join(RESULTS, "rostest", name)
+    shutil.rmtree(base, ignore_errors=True)
+    os.makedirs(base)
+    log_path = os.path.join(base, "console.log")
+    started = time.monotonic()
+    env = dict(os.environ, ROS_HOME=os.path.join(base, "ros_home"))
+    with open(log_path, "w") as log:
+        try:
+            proc = subprocess.run(["rostest", "--results-base-dir", base, "diffbot_sim", os.path.basename(test_file)],
+                                  stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, env=env,
+                                  timeout=600)
+            code = proc.returncode
+        except subprocess.TimeoutExpired:
+            code = "timeout"
+    xmls = [p for p in glob.glob(os.path.join(base, "**", "*.xml"), recursive=True)
+            if not os.path.basename(p).startswith("rostest-")]
+    passed, failed, skipped, names = count_junit(xmls)
+    summary = glob.glob(os.path.join(base, "**", "rostest-*.xml"), recursive=True)
+    _, s_failed, _, s_names = count_junit(summary)
+    if s_failed and not failed:
+        failed, names = s_failed, s_names  # e.g. "test node did not generate test results" (it crashed)
+    if code != 0 and failed == 0:
+        failed, names = failed + 1, names + [f"{name}: rostest exited {code} (see {log_path})"]
+    if passed + failed == 0:
+        failed, names = 1, [f"{name}: ran no test (see {log_path})"]
+    return name, passed, failed, skipped, names, time.monotonic() - started
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--slow", action="store_true", help="also run slow suites (slow_*.test, pytest -m slow)")
+    parser.add_argument("--only", default=None, help="run only rostest suites whose name contains this")
+    parser.add_argument("--jobs", type=int, default=2)
+    args = parser.parse_args()
+    os.makedirs(RESULTS, exist_ok=True)
+    total_p = total_f = total_s = 0
+    failures = []
+    if args.only is None:
+        p, f, s, n = run_pytest(args.slow)
+        total_p, total_f, total_s = p, f, s
+        failures += n
+    suites = sorted(glob.glob(os.path.join(ROOT, "tests", "integration", "*.test")))
+    if not args.slow:
+        suites = [t for t in suites if not os.path.basename(t).startswith("slow_")]
+    if args.only:
+        suites = [t for t in suites if args.only in os.path.basename(t)]
+    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        for name, p, f, s, n, secs in pool.map(run_rostest, suites):
+            print(f"[tests] rostest {name}: {p} passed, {f} failed ({secs:.0f} s)", flush=True)
+            total_p, total_f, total_s = total_p + p, total_f + f, total_s + s
+            failures += n
+    for name in failures:
+        print(f"[tests] FAILED: {name}")
+    line = f"{total_p} passed, {total_f} failed"
+    if total_s:
+        line += f", {total_s} skipped"
+    print(line, flush=True)
+    return 1 if total_f else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
