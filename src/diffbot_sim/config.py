@@ -35,6 +35,7 @@ class SimConfig:
     z: float = 0.0
     yaw: float = 0.0  # rad
     debug_cmd_applied: bool = False  # publish ~debug/cmd_applied (wall time a command reached the motors)
+    publish_ground_truth: bool = False  # publish ~ground_truth (physics pose, like Gazebo's p3d plugin)
 
 
 @dataclass
@@ -90,7 +91,7 @@ def sim_config(params):
     name = lambda k: f"~{k}"  # noqa: E731
     cfg.model = _string(name("model"), cfg.model, allow_empty=True)
     cfg.model_args = _string(name("model_args"), cfg.model_args, allow_empty=True)
-    for key in ("gui", "real_time", "debug_cmd_applied"):
+    for key in ("gui", "real_time", "debug_cmd_applied", "publish_ground_truth"):
         setattr(cfg, key, _bool(name(key), getattr(cfg, key)))
     cfg.time_step = _number(name("time_step"), cfg.time_step, low=1e-5, high=0.05)
     cfg.real_time_factor = _number(name("real_time_factor"), cfg.real_time_factor, low=1e-3)
@@ -126,6 +127,9 @@ def drive_config(model, block, params):
     for values, label in sources:
         for key, value in values.items():
             setattr(cfg, key, _drive_value(key, value, label(key)))
+    if block is not None and block.dialect == "ros1" and "publish_odom_tf" not in given \
+            and block.values.get("publish_odom") is not None and not cfg.publish_odom:
+        cfg.publish_odom_tf = False  # ROS 1 publishTf=false removes the odom topic and its TF together
     referrer = block.path if block is not None else "~left_joints"
     if not cfg.left_joints or not cfg.right_joints or len(cfg.left_joints) != len(cfg.right_joints):
         raise ConfigError("left_joints/right_joints", (cfg.left_joints, cfg.right_joints),

@@ -1,7 +1,8 @@
 """The only place message objects are built (message modules only; no rospy).
 
-Builders fill message objects the caller owns and re-uses, so the simulator allocates nothing per publish.
-Stamps are passed in (sim time, as a genpy/rospy Time).
+Each call returns a new message: rospy's queued publishers serialize on another thread later, so a message
+object must never be refilled after ``publish()``. What is constant (frames, names, covariance) is computed
+once by the builder. Stamps are passed in (sim time, as a genpy/rospy Time).
 """
 from geometry_msgs.msg import TransformStamped
 from nav_msgs.msg import Odometry
@@ -10,41 +11,42 @@ from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 
 
-def new_odometry(frame, child, cov_x, cov_y, cov_yaw):
-    """An Odometry with frames and covariance diagonals set once. z, roll, pitch are unobserved: 1e12."""
-    msg = Odometry()
-    msg.header.frame_id = frame
-    msg.child_frame_id = child
-    diagonal = (cov_x, cov_y, 1e12, 1e12, 1e12, cov_yaw)
+def covariance_diagonal(cov_x, cov_y, cov_yaw):
+    """6x6 row-major covariance with x, y, yaw given; z, roll and pitch are unobserved (1e12)."""
     cov = [0.0] * 36
-    for i, value in enumerate(diagonal):
+    for i, value in enumerate((cov_x, cov_y, 1e12, 1e12, 1e12, cov_yaw)):
         cov[i * 7] = value
-    msg.pose.covariance = list(cov)
-    msg.twist.covariance = list(cov)
-    return msg
+    return cov
 
 
-def fill_odometry(msg, stamp, position, orientation, linear, angular):
-    """Pose in the odometry frame; twist in the child (base) frame, signed."""
-    msg.header.stamp = stamp
-    p, q = msg.pose.pose.position, msg.pose.pose.orientation
-    p.x, p.y, p.z = position
-    q.x, q.y, q.z, q.w = orientation
-    v, w = msg.twist.twist.linear, msg.twist.twist.angular
-    v.x, v.y, v.z = linear
-    w.x, w.y, w.z = angular
-    return msg
+class OdometryBuilder:
+    """Odometry in ``frame`` for ``child``: pose in the odometry frame, twist in the child frame (signed)."""
+
+    def __init__(self, frame, child, cov_x, cov_y, cov_yaw):
+        self.frame, self.child = frame, child
+        self.covariance = covariance_diagonal(cov_x, cov_y, cov_yaw)
+
+    def build(self, stamp, position, orientation, linear, angular):
+        msg = Odometry()
+        msg.header.stamp = stamp
+        msg.header.frame_id = self.frame
+        msg.child_frame_id = self.child
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        p.x, p.y, p.z = position
+        q.x, q.y, q.z, q.w = orientation
+        v, w = msg.twist.twist.linear, msg.twist.twist.angular
+        v.x, v.y, v.z = linear
+        w.x, w.y, w.z = angular
+        msg.pose.covariance = self.covariance
+        msg.twist.covariance = self.covariance
+        return msg
 
 
-def new_transform(frame, child):
+def transform(stamp, frame, child, position, orientation):
     msg = TransformStamped()
+    msg.header.stamp = stamp
     msg.header.frame_id = frame
     msg.child_frame_id = child
-    return msg
-
-
-def fill_transform(msg, stamp, position, orientation):
-    msg.header.stamp = stamp
     t, r = msg.transform.translation, msg.transform.rotation
     t.x, t.y, t.z = position
     r.x, r.y, r.z, r.w = orientation
@@ -56,14 +58,10 @@ def tf_message(transforms):
     return TFMessage(transforms=list(transforms))
 
 
-def new_joint_state(names):
+def joint_state(stamp, names, positions, velocities, efforts):
     msg = JointState()
-    msg.name = list(names)
-    return msg
-
-
-def fill_joint_state(msg, stamp, positions, velocities, efforts):
     msg.header.stamp = stamp
+    msg.name = names
     msg.position = positions
     msg.velocity = velocities
     msg.effort = efforts

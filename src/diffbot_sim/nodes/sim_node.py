@@ -95,7 +95,7 @@ class RobotRuntime:
             self.controller = None
         if joint_cfg is not None:
             self.js_indices = robot.indices(joint_cfg.joints)
-            self.js_msg = ros_msgs.new_joint_state(joint_cfg.joints)
+            self.js_names = list(joint_cfg.joints)
             self.js_pub = _publisher(_join(joint_cfg.namespace, joint_cfg.topic), JointState, sync)
             self.js_period = 1.0 / joint_cfg.update_rate if joint_cfg.update_rate > 0 else 0.0
         for joint, trans in self.motor_joints.items():
@@ -138,17 +138,30 @@ class RobotRuntime:
         self.odom_pub = None
         if drive.publish_odom:
             self.odom_pub = _publisher(_join(ns, drive.odometry_topic), Odometry, sync)
-            self.odom_msg = ros_msgs.new_odometry(drive.odometry_frame, drive.robot_base_frame,
-                                                  drive.covariance_x, drive.covariance_y, drive.covariance_yaw)
-            self.tf_msg = ros_msgs.new_transform(drive.odometry_frame, drive.robot_base_frame)
+        self.odom_builder = ros_msgs.OdometryBuilder(drive.odometry_frame, drive.robot_base_frame,
+                                                     drive.covariance_x, drive.covariance_y, drive.covariance_yaw)
+        self.truth_pub = None
+        if cfg.publish_ground_truth:
+            self.truth_pub = _publisher("~ground_truth", Odometry, sync)
+            self.truth_builder = ros_msgs.OdometryBuilder("world", drive.robot_base_frame, 0.0, 0.0, 0.0)
         self.debug_pub = None
         if cfg.debug_cmd_applied:
             self.debug_pub = _publisher("~debug/cmd_applied", TwistStamped, False)
 
     def _on_twist(self, msg):
-        """Subscriber thread: keep only the newest command; the loop applies it at its next step."""
+        """Subscriber thread: keep the newest *valid* command; the loop applies it at its next step.
+
+        Validating here (not in the loop) means a burst of a good command followed by a NaN one keeps the
+        good one, as diff_drive_controller does.
+        """
+        values = ros_msgs.twist_values(msg)
+        bad = non_finite_field(values)
+        if bad is not None:
+            self.sim.warn(f"nonfinite:{id(self)}", f"ignored a cmd_vel with a non-finite {bad} {values}; "
+                          "the robot keeps its last valid command")
+            return
         with self._lock:
-            self._pending_twist = msg
+            self._pending_twist = values
         self.sim.wake.set()
 
     def _on_joint_command(self, msg, joint):
@@ -171,14 +184,7 @@ class RobotRuntime:
             return
         fresh = False
         if twist is not None:
-            values = ros_msgs.twist_values(twist)
-            bad = non_finite_field(values)
-            if bad is not None:
-                self.sim.warn(f"nonfinite:{id(self)}",
-                              f"ignored a cmd_vel with a non-finite {bad} ({values}); the robot keeps its "
-                              "last valid command")
-            else:
-                fresh = self.controller.set_command(values[0], values[5], now)
+            fresh = self.controller.set_command(twist[0], twist[5], now)
         expiry = self.controller.expiry()
         stale = expiry is not None and now >= expiry
         if fresh or stale or now + 1e-9 >= self.next_update:
@@ -195,7 +201,7 @@ class RobotRuntime:
             if fresh and self.debug_pub is not None:
                 out = TwistStamped()
                 out.header.stamp = rospy.Time.from_sec(time.time())
-                out.twist = twist
+                out.twist.linear.x, out.twist.angular.z = twist[0], twist[5]
                 self.debug_pub.publish(out)
 
     def _apply_joint_command(self, joint, value, now):
@@ -215,16 +221,20 @@ class RobotRuntime:
 
     def after_step(self, now, stamp):
         """Publish what is due at sim time ``now``. Called by the loop after each step."""
-        if self.controller is not None and self.odom_pub is not None and now + 1e-9 >= self.next_odom:
+        if self.controller is not None and now + 1e-9 >= self.next_odom:
             self.next_odom = _next_due(self.next_odom, self.update_period, now)
             self._publish_odometry(now, stamp)
         if self.joint_cfg is not None and now + 1e-9 >= self.next_js:
             self.next_js = _next_due(self.next_js, self.js_period, now)
             positions, velocities, efforts = self.robot.joint_states(self.js_indices)
-            self.js_pub.publish(ros_msgs.fill_joint_state(self.js_msg, stamp, positions, velocities, efforts))
+            self.js_pub.publish(ros_msgs.joint_state(stamp, self.js_names, positions, velocities, efforts))
 
     def _publish_odometry(self, now, stamp):
         drive = self.drive
+        if self.truth_pub is not None:
+            pose = self.robot.base_pose()
+            linear, angular = self.robot.base_twist(pose)
+            self.truth_pub.publish(self.truth_builder.build(stamp, pose[0], pose[1], linear, angular))
         if drive.odometry_source == "encoder":
             positions, _, _ = self.robot.joint_states([self.left_idx[0], self.right_idx[0]])
             self.encoder.update(positions[0], positions[1], now)
@@ -236,11 +246,11 @@ class RobotRuntime:
         else:
             position, orientation = self.robot.base_pose()
             linear, angular = self.robot.base_twist((position, orientation))
-        ros_msgs.fill_odometry(self.odom_msg, stamp, position, orientation, linear, angular)
-        self.odom_pub.publish(self.odom_msg)
+        if self.odom_pub is not None:
+            self.odom_pub.publish(self.odom_builder.build(stamp, position, orientation, linear, angular))
         if drive.publish_odom_tf:
-            ros_msgs.fill_transform(self.tf_msg, stamp, position, orientation)
-            self.sim.tf_pub.publish(ros_msgs.tf_message([self.tf_msg]))
+            tf = ros_msgs.transform(stamp, drive.odometry_frame, drive.robot_base_frame, position, orientation)
+            self.sim.tf_pub.publish(ros_msgs.tf_message([tf]))
 
     def reset(self, now):
         if self.controller is not None:

@@ -1,0 +1,142 @@
+"""Shared helpers for the rostest test nodes: record what the simulator publishes, wait with deadlines.
+
+Callbacks only record; the test thread asserts. Waits poll a predicate against a wall-clock deadline.
+"""
+import math
+import threading
+import time
+
+import rospy
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_srvs.srv import Empty
+from tf2_msgs.msg import TFMessage
+
+SIM = "/bullet_sim"
+
+
+def yaw_of(q):
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def finite_odom(msg):
+    p, q = msg.pose.pose.position, msg.pose.pose.orientation
+    v, w = msg.twist.twist.linear, msg.twist.twist.angular
+    return all(math.isfinite(x) for x in (p.x, p.y, p.z, q.x, q.y, q.z, q.w, v.x, v.y, v.z, w.x, w.y, w.z))
+
+
+class Recorder:
+    """Subscribes the standard topics and keeps every message with its receipt time."""
+
+    def __init__(self, odom="/odom", joint_states="/joint_states", extra_odom=None):
+        self.lock = threading.Lock()
+        self.odom, self.joints, self.clock, self.tf, self.extra = [], [], [], [], []
+        self.subs = [
+            rospy.Subscriber(odom, Odometry, self._keep, callback_args=self.odom, queue_size=1000),
+            rospy.Subscriber(joint_states, JointState, self._keep, callback_args=self.joints, queue_size=1000),
+            rospy.Subscriber("/clock", Clock, self._keep, callback_args=self.clock, queue_size=1000),
+            rospy.Subscriber("/tf", TFMessage, self._keep, callback_args=self.tf, queue_size=1000),
+        ]
+        if extra_odom:
+            self.subs.append(rospy.Subscriber(extra_odom, Odometry, self._keep, callback_args=self.extra,
+                                              queue_size=1000))
+        self.cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=10)
+
+    def _keep(self, msg, store):
+        with self.lock:
+            store.append(msg)
+
+    def last(self, store):
+        with self.lock:
+            return store[-1] if store else None
+
+    def snapshot(self, store):
+        with self.lock:
+            return list(store)
+
+    def clear(self):
+        with self.lock:
+            for store in (self.odom, self.joints, self.clock, self.tf, self.extra):
+                del store[:]
+
+    def wait(self, predicate, timeout, what):
+        """Poll ``predicate`` until true or ``timeout`` wall seconds pass; then raise AssertionError(what)."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline and not rospy.is_shutdown():
+            value = predicate()
+            if value:
+                return value
+            time.sleep(0.01)
+        raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+
+    def wait_connected(self, timeout=20.0):
+        self.wait(lambda: self.cmd.get_num_connections() > 0, timeout, "the simulator to subscribe /cmd_vel")
+        self.wait(lambda: self.last(self.odom) is not None, timeout, "a first odom message")
+
+    def sim_time(self):
+        """Sim time as seen on odom (not /clock: in fast mode the odom subscriber may lag the clock one)."""
+        msg = self.last(self.odom)
+        return msg.header.stamp.to_sec() if msg else 0.0
+
+    def wait_sim(self, seconds, timeout=60.0):
+        """Wait until sim time has advanced by ``seconds``; returns the new sim time."""
+        start = self.sim_time()
+        return self.wait(lambda: self.sim_time() >= start + seconds and self.sim_time(), timeout,
+                         f"sim time to advance {seconds} s from {start:.3f}")
+
+    def odom_after(self, sim_time, timeout=60.0, store=None):
+        """The first odom message stamped at or after ``sim_time``."""
+        store = self.odom if store is None else store
+
+        def find():
+            for msg in reversed(self.snapshot(store)):
+                if msg.header.stamp.to_sec() < sim_time:
+                    break
+            for msg in self.snapshot(store):
+                if msg.header.stamp.to_sec() >= sim_time:
+                    return msg
+            return None
+        return self.wait(find, timeout, f"odom stamped after {sim_time:.3f}")
+
+    def send(self, linear=0.0, angular=0.0, **fields):
+        msg = Twist()
+        msg.linear.x, msg.angular.z = linear, angular
+        for name, value in fields.items():
+            part, axis = name.split("_")
+            setattr(getattr(msg, part), axis, value)
+        self.cmd.publish(msg)
+        return msg
+
+    def send_until_seen(self, linear, angular, timeout=10.0):
+        """Publish a command and wait until odom shows the robot responding to it."""
+        self.send(linear, angular)
+
+        def moving():
+            msg = self.last(self.odom)
+            if msg is None:
+                return False
+            twist = msg.twist.twist
+            return ((linear == 0 or twist.linear.x * linear > 0.2 * linear * linear) and
+                    (angular == 0 or twist.angular.z * angular > 0.2 * angular * angular))
+        return self.wait(moving, timeout, f"the robot to respond to ({linear}, {angular})")
+
+
+def call(service):
+    rospy.wait_for_service(service, timeout=20.0)
+    rospy.ServiceProxy(service, Empty)()
+
+
+def reset_robot(rec):
+    """Zero the command, reset the simulation, and wait until odom shows the robot back at rest."""
+    rec.send(0.0, 0.0)
+    call(SIM + "/reset_simulation")
+    t = rec.sim_time()
+    rec.wait_sim(0.3)
+
+    def at_rest():
+        msg = rec.odom_after(t + 0.25)
+        p = msg.pose.pose.position
+        return abs(p.x) < 0.01 and abs(p.y) < 0.01 and abs(msg.twist.twist.linear.x) < 0.01
+    rec.wait(at_rest, 20.0, "the robot at rest at the origin after reset")
