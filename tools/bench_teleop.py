@@ -15,6 +15,7 @@ core; once with nothing on ``odom`` and once while this script publishes Odometr
 then redraws the pose).
 """
 import argparse
+import math
 import os
 import pty
 import select
@@ -59,9 +60,9 @@ def idle_cpu(pid, seconds):
 
 
 def percentile(values, q):
+    """Nearest-rank percentile."""
     ordered = sorted(values)
-    index = min(len(ordered) - 1, max(0, int(round(q / 100.0 * len(ordered) + 0.5)) - 1))
-    return ordered[index]
+    return ordered[max(0, math.ceil(q / 100.0 * len(ordered)) - 1)]
 
 
 class Drain(threading.Thread):
@@ -155,7 +156,6 @@ def main():
 
         os.write(master, b"\x03")
         code = teleop.wait(10.0)
-        threads = "n/a"
         ms = [1000.0 * x for x in latencies]
         load = os.getloadavg()
         print(f"| keypress -> Twist latency, {len(ms)} keys | median {statistics.median(ms):.2f} ms, "
@@ -165,7 +165,6 @@ def main():
         print(f"| teleop exit status after Ctrl-C | {code} |")
         print(f"| load average during the run (1/5/15 min) | {load[0]:.2f} / {load[1]:.2f} / {load[2]:.2f} "
               f"on {os.cpu_count()} cores |")
-        del threads
         rospy.signal_shutdown("done")
         return 0
     finally:

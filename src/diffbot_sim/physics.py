@@ -10,9 +10,6 @@ import os
 import tempfile
 import xml.etree.ElementTree as ET
 
-import pybullet
-import pybullet_data
-
 from .errors import ModelError
 
 #: Mass [kg] given to a root link that has no <inertial>. PyBullet would give it 1 kg (a phantom kilo
@@ -21,20 +18,26 @@ ROOT_PLACEHOLDER_MASS = 1e-6
 
 
 @contextlib.contextmanager
-def _quiet_stdout():
-    """PyBullet's C code prints link-merging chatter on fd 1; keep the node's stdout clean while loading."""
+def _quiet(fd):
+    """Silence a file descriptor: PyBullet's C code prints a build banner on import (stderr) and
+    link-merging chatter while loading (stdout), which would break the one-line error contract."""
     try:
-        fd = os.dup(1)
+        saved = os.dup(fd)
     except OSError:
         yield
         return
     try:
         with open(os.devnull, "w") as null:
-            os.dup2(null.fileno(), 1)
+            os.dup2(null.fileno(), fd)
         yield
     finally:
-        os.dup2(fd, 1)
-        os.close(fd)
+        os.dup2(saved, fd)
+        os.close(saved)
+
+
+with _quiet(1), _quiet(2):
+    import pybullet
+    import pybullet_data
 
 
 def prepare_urdf(text, root_link):
@@ -85,7 +88,7 @@ class World:
         flags = (pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_MERGE_FIXED_LINKS
                  | pybullet.URDF_USE_IMPLICIT_CYLINDER)
         orientation = pybullet.getQuaternionFromEuler((0.0, 0.0, yaw))
-        with _quiet_stdout():
+        with _quiet(1):
             body = pybullet.loadURDF(path, position, orientation, flags=flags, physicsClientId=self.client)
         if body < 0:
             raise ModelError("PyBullet could not load the model", model.source)

@@ -1,5 +1,6 @@
 """config.py: SimConfig, DriveConfig and JointStateConfig from defaults, plugin tags and private params."""
 import math
+import os
 
 import pytest
 
@@ -8,7 +9,12 @@ from diffbot_sim.config import (FALLBACK_MAX_WHEEL_VELOCITY, SimConfig, as_param
 from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.plugins import read_plugins
 
-from test_plugins import ROS1_DIFF_DRIVE, _gazebo
+with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "ros1_diff_drive.xml")) as _f:
+    ROS1_DIFF_DRIVE = _f.read()
+
+
+def _gazebo(*plugins):
+    return "\n  <gazebo>" + "".join(plugins) + "</gazebo>"
 
 
 def _drive(parse, make_urdf, plugin=None, params=None, **urdf):
@@ -87,6 +93,14 @@ def test_no_joint_state_without_plugin_or_flag(parse, make_urdf):
     model = parse(make_urdf(gazebo=_gazebo(_ros1(""))))
     plugins = read_plugins(model)
     assert joint_state_config(model, plugins.joint_state, drive_config(model, plugins.diff_drive, {})) is None
+
+
+def test_ros1_publish_tf_false_turns_off_odom_and_its_tf(parse, make_urdf):
+    cfg = _drive(parse, make_urdf, _ros1("<publishTf>false</publishTf>"))
+    assert cfg.publish_odom is False and cfg.publish_odom_tf is False
+    # an explicit parameter still wins
+    cfg = _drive(parse, make_urdf, _ros1("<publishTf>false</publishTf>"), params={"publish_odom_tf": True})
+    assert cfg.publish_odom is False and cfg.publish_odom_tf is True
 
 
 def test_ros1_defaults_publish(parse, make_urdf):
@@ -296,6 +310,7 @@ def test_sim_config_values_and_coercion():
     ("time_step", 0), ("time_step", -0.01), ("time_step", float("nan")), ("time_step", 1.0),
     ("time_step", True), ("time_step", "fast"), ("gui", "maybe"), ("real_time", 2),
     ("cmd_vel_timeout", -1), ("clock_rate", 0), ("gravity", float("inf")), ("model", 3),
+    ("publish_ground_truth", "yes please"),
 ])
 def test_sim_config_rejects(key, value):
     with pytest.raises(ConfigError) as info:

@@ -1,4 +1,6 @@
 """plugins.py: the <gazebo><plugin> blocks in both dialects, as canonical raw values."""
+import os
+
 import pytest
 
 from diffbot_sim.errors import ModelError
@@ -9,28 +11,8 @@ def _gazebo(*plugins):
     return "\n  <gazebo>" + "".join(plugins) + "</gazebo>"
 
 
-ROS1_DIFF_DRIVE = """
-    <plugin name="differential_drive_controller" filename="libgazebo_ros_diff_drive.so">
-      <legacyMode>false</legacyMode>
-      <rosDebugLevel>na</rosDebugLevel>
-      <alwaysOn>true</alwaysOn>
-      <updateRate>50</updateRate>
-      <leftJoint>left_wheel_joint</leftJoint>
-      <rightJoint>right_wheel_joint</rightJoint>
-      <wheelSeparation>0.31</wheelSeparation>
-      <wheelDiameter>0.11</wheelDiameter>
-      <wheelTorque>12</wheelTorque>
-      <wheelAcceleration>2.5</wheelAcceleration>
-      <commandTopic>mobile/cmd_vel</commandTopic>
-      <odometryTopic>mobile/odom</odometryTopic>
-      <odometryFrame>odom_frame</odometryFrame>
-      <robotBaseFrame>base_link</robotBaseFrame>
-      <odometrySource>encoder</odometrySource>
-      <publishOdomTF>false</publishOdomTF>
-      <publishWheelJointState>true</publishWheelJointState>
-      <publishWheelTF>false</publishWheelTF>
-      <robotNamespace>/bot1</robotNamespace>
-    </plugin>"""
+with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "ros1_diff_drive.xml")) as _f:
+    ROS1_DIFF_DRIVE = _f.read()
 
 
 def test_seed_ros2_block(seed_model):

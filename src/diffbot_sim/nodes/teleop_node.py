@@ -73,8 +73,8 @@ def main():
         rospy.on_shutdown(out.final_stop)
         odom = _LatestOdom()
         rospy.Subscriber("odom", Odometry, odom.store, queue_size=1)
-        rospy.loginfo("%s: publishing on %s; speed %.3g m/s, turn %.3g rad/s, repeat_rate %.3g Hz, "
-                      "key_timeout %.3g s, limits %.3g m/s / %.3g rad/s", rospy.get_name(), out.topic,
+        rospy.loginfo("%s: publishing on %s; speed %g m/s, turn %g rad/s, repeat_rate %g Hz, "
+                      "key_timeout %g s, limits %g m/s / %g rad/s", rospy.get_name(), out.topic,
                       config.speed, config.turn, config.repeat_rate, config.key_timeout,
                       config.speed_limit, config.turn_limit)
         reason = _run(stdin, Teleop(config), out, odom, signals)

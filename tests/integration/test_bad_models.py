@@ -1,0 +1,82 @@
+#!/usr/bin/env python3
+"""Bad models fail fast: non-zero exit within 5 s, one line naming the culprit, no traceback, no odom."""
+import os
+import subprocess
+import sys
+import time
+import unittest
+
+import rosgraph
+import rospkg
+import rospy
+import rostest
+
+DATA = os.path.join(rospkg.RosPack().get_path("diffbot_sim"), "tests", "data")
+
+
+class BadModelTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_bad_models")
+        cls.master = rosgraph.Master("/test_bad_models")
+        cls.count = 0
+
+    def _odom_published(self):
+        return any(topic.endswith("/odom") for topic, _ in self.master.getPublishedTopics(""))
+
+    def _run(self, model, culprit, extra=()):
+        BadModelTest.count += 1
+        args = ["rosrun", "diffbot_sim", "bullet_sim", f"__name:=bad_{self.count}", *extra]
+        if model is not None:
+            args.append(f"_model:={model}")
+        started = time.monotonic()
+        proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                stdin=subprocess.DEVNULL)
+        saw_odom = False
+        while proc.poll() is None and time.monotonic() - started < 10.0:
+            saw_odom = saw_odom or self._odom_published()
+            time.sleep(0.05)
+        if proc.poll() is None:
+            proc.kill()
+        out, err = proc.communicate()
+        elapsed = time.monotonic() - started
+        lines = [line for line in err.splitlines() if line.strip()]
+        self.assertNotEqual(proc.returncode, 0, f"exit status for {model}")
+        self.assertLess(elapsed, 5.0, f"failed within 5 s ({elapsed:.1f} s)")
+        self.assertNotIn("Traceback", err + out)
+        self.assertEqual(len(lines), 1, f"one line on stderr, got: {lines}")
+        self.assertIn(culprit, lines[0])
+        self.assertFalse(saw_odom, "no odom publisher appeared")
+        return lines[0]
+
+    def test_missing_file(self):
+        self._run("/nonexistent/robot.urdf", "/nonexistent/robot.urdf")
+
+    def test_xacro_error(self):
+        line = self._run(os.path.join(DATA, "bad_xacro.urdf.xacro"), "bad_xacro.urdf.xacro")
+        self.assertIn("does_not_exist.xacro", line)
+
+    def test_truncated_xml(self):
+        self._run(os.path.join(DATA, "truncated.urdf"), "malformed XML")
+
+    def test_transmission_names_missing_joint(self):
+        self._run(os.path.join(DATA, "missing_joint_transmission.urdf"), "leftt_wheel_joint")
+
+    def test_plugin_names_missing_joint(self):
+        self._run(os.path.join(DATA, "missing_joint_plugin.urdf"), "no_such_joint")
+
+    def test_effort_interface_on_drive_wheel(self):
+        self._run(os.path.join(DATA, "effort_drive_wheel.urdf"), "EffortJointInterface")
+
+    def test_zero_wheel_radius(self):
+        self._run(os.path.join(DATA, "zero_radius.urdf"), "radius")
+
+    def test_negative_wheel_diameter(self):
+        self._run(os.path.join(DATA, "negative_diameter.urdf"), "wheel_diameter")
+
+    def test_missing_robot_description(self):
+        self._run(None, "robot_description")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("diffbot_sim", "test_bad_models", BadModelTest, sys.argv)
