@@ -46,7 +46,7 @@ def count_junit(paths):
 def run_pytest(slow):
     out = os.path.join(RESULTS, "pytest.xml")
     cmd = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", f"--junitxml={out}",
-           os.path.join(ROOT, "tests", "unit")]
+           os.path.join(ROOT, "tests", "unit"), os.path.join(ROOT, "tests", "system")]
     if not slow:
         cmd += ["-m", "not slow"]
     started = time.monotonic()

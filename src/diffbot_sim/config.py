@@ -122,7 +122,7 @@ def drive_config(model, block, params):
             setattr(cfg, key, value)
     sources = []
     if block is not None:
-        sources.append((block.values, lambda k: f"<{k}> of {block.path}"))
+        sources.append((block.values, lambda k: f"<{block.tag(k)}> of {block.path}"))
     sources.append((given, lambda k: f"~{k}"))
     for values, label in sources:
         for key, value in values.items():

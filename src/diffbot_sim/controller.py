@@ -7,7 +7,7 @@ in (sim seconds); the simulator alone owns it.
 import math
 
 from .kinematics import wheel_speeds
-from .limits import clamp, ramp, scale_to_limit
+from .limits import ramp, scale_to_limit
 
 TWIST_FIELDS = ("linear.x", "linear.y", "linear.z", "angular.x", "angular.y", "angular.z")
 
@@ -39,6 +39,7 @@ class DiffDriveController:
         self.linear = self.angular = 0.0
         self.stamp = None  # sim time of the last accepted command
         self.targets = (0.0, 0.0)
+        self._braking = False  # a stale command stopped the wheels; hold them until a new command
 
     @property
     def max_linear(self):
@@ -51,9 +52,12 @@ class DiffDriveController:
         """
         if not (math.isfinite(linear) and math.isfinite(angular)):
             return False
-        self.linear = clamp(linear, self.max_linear)
-        self.angular = clamp(angular, 2.0 * self.max_linear / self.separation)
+        # Scale both by one factor (keeps the curvature) so even 1e308 stays far from overflow in the
+        # kinematics; the wheel-speed limit in update() then does the real limiting.
+        factor = max(1.0, abs(linear) / self.max_linear, abs(angular) * self.separation / (2.0 * self.max_linear))
+        self.linear, self.angular = linear / factor, angular / factor
         self.stamp = now
+        self._braking = False
         return True
 
     def brake(self):
@@ -77,8 +81,11 @@ class DiffDriveController:
         expiry = self.expiry()
         if expiry is not None and now >= expiry:
             # A stale command is a safety stop: brake at once (the motor torque limit still bounds the
-            # deceleration physically) rather than ramping down over the acceleration limit.
+            # deceleration physically) rather than ramping down over the acceleration limit, and keep
+            # braking until a new command arrives.
             self.linear = self.angular = 0.0
+            self._braking = True
+        if self._braking:
             self.targets = (0.0, 0.0)
             return self.targets
         left, right = wheel_speeds(self.linear, self.angular, self.separation)

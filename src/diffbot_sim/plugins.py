@@ -52,10 +52,11 @@ class PluginBlock:
     dialect: str  # "ros1" or "ros2"
     values: Dict[str, object] = field(default_factory=dict)
     unknown_tags: List[str] = field(default_factory=list)
+    tags: Dict[str, str] = field(default_factory=dict)  # canonical key -> the tag as written
 
-    def where(self, key):
-        """Element path of a canonical key, for error messages."""
-        return f"{self.path}/{key}"
+    def tag(self, key):
+        """The tag the model used for a canonical key (for error messages that point at the file)."""
+        return self.tags.get(key, key)
 
 
 @dataclass
@@ -116,6 +117,7 @@ def _read_diff_drive(el, path):
             if child.tag not in _IGNORED:
                 block.unknown_tags.append(child.tag)
             continue
+        block.tags[key] = child.tag
         if key in _LIST_KEYS:
             block.values.setdefault(key, []).extend(_split_names(text))
         else:

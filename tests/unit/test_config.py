@@ -211,8 +211,6 @@ def test_bad_param_values(seed_model, key, value):
     assert f"parameter ~{key}:" in str(info.value)
 
 
-@pytest.mark.xfail(strict=True, reason="config.drive_config labels tag errors with the canonical snake_case key "
-                   "(<wheel_diameter>), not the ROS 1 tag the model actually contains (<wheelDiameter>)")
 def test_bad_ros1_tag_error_names_the_tag_written(parse, make_urdf):
     with pytest.raises(ConfigError) as info:
         _drive(parse, make_urdf, _ros1("<wheelDiameter>-0.1</wheelDiameter>"))
