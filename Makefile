@@ -3,7 +3,7 @@ SHELL := /bin/bash
 ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
 ENV := $(ROOT)/tools/rosenv.sh
 
-.PHONY: setup run test test-slow bench unit clean
+.PHONY: setup run test test-slow unit clean
 
 setup:
 	@bash $(ROOT)/tools/setup.sh
@@ -20,8 +20,6 @@ test-slow: setup
 unit: setup
 	@bash $(ENV) python3 -m pytest -q $(ROOT)/tests/unit
 
-bench: setup
-	@bash $(ENV) python3 $(ROOT)/tools/bench.py
 
 clean:
 	rm -rf $(ROOT)/catkin_ws/build $(ROOT)/catkin_ws/devel $(ROOT)/catkin_ws/src $(ROOT)/test-results
