@@ -132,11 +132,11 @@ def reset_robot(rec):
     """Zero the command, reset the simulation, and wait until odom shows the robot back at rest."""
     rec.send(0.0, 0.0)
     call(SIM + "/reset_simulation")
-    t = rec.sim_time()
-    rec.wait_sim(0.3)
+    after = rec.sim_time() + 0.1  # the service returned: anything stamped later follows the reset
 
     def at_rest():
-        msg = rec.odom_after(t + 0.25)
+        msg = rec.last(rec.odom)
         p = msg.pose.pose.position
-        return abs(p.x) < 0.01 and abs(p.y) < 0.01 and abs(msg.twist.twist.linear.x) < 0.01
+        return (msg.header.stamp.to_sec() > after and abs(p.x) < 0.01 and abs(p.y) < 0.01
+                and abs(msg.twist.twist.linear.x) < 0.01 and abs(msg.twist.twist.angular.z) < 0.01)
     rec.wait(at_rest, 20.0, "the robot at rest at the origin after reset")
