@@ -14,6 +14,8 @@ from .errors import ConfigError, ModelError
 #: Wheel speed cap [rad/s] when neither ``~max_wheel_velocity`` nor the URDF ``<limit velocity>`` gives one:
 #: keeps a 1e308 command from reaching the physics as an absurd motor target.
 FALLBACK_MAX_WHEEL_VELOCITY = 100.0
+#: Effort limit [N·m] for a commanded non-drive joint whose URDF gives no <limit effort>.
+FALLBACK_JOINT_EFFORT = 100.0
 
 
 @dataclass

@@ -19,7 +19,6 @@ Parameters: see diffbot_sim.config.SimConfig and DriveConfig (README table).
 """
 import math
 import os
-import sys
 import threading
 import time
 import warnings
@@ -211,7 +210,7 @@ class RobotRuntime:
             self.sim.warn(f"joint:{joint}", f"ignored a non-finite command for joint {joint}")
             return
         limit = self.model.joints[joint].effort_limit
-        force = limit if limit else cfgmod.FALLBACK_MAX_WHEEL_VELOCITY  # N·m: something finite
+        force = limit if limit else cfgmod.FALLBACK_JOINT_EFFORT
         if trans.interface == "VelocityJointInterface":
             self.robot.set_velocities(idx, [value], [force])
         elif trans.interface == "PositionJointInterface":
@@ -252,12 +251,11 @@ class RobotRuntime:
             tf = ros_msgs.transform(stamp, drive.odometry_frame, drive.robot_base_frame, position, orientation)
             self.sim.tf_pub.publish(ros_msgs.tf_message([tf]))
 
-    def reset(self, now):
+    def reset(self):
+        """Brake and drop pending commands; the caller re-anchors the encoder (start_encoder)."""
         if self.controller is not None:
             self.controller.brake()
             self.robot.set_velocities(self.wheel_idx, [0.0] * len(self.wheel_idx), self.wheel_forces)
-            self.encoder._time = None  # re-anchor at the next update
-            self.encoder.x = self.encoder.y = self.encoder.yaw = 0.0
         with self._lock:
             self._pending_twist = None
             self._joint_commands = {}
@@ -330,7 +328,7 @@ class Simulator:
                 self.world.reset()
                 now = self.sim_time
                 for runtime in self.robots:
-                    runtime.reset(now)
+                    runtime.reset()
                     runtime.start_encoder(now)
             done.set()
 
