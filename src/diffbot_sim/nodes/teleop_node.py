@@ -57,8 +57,14 @@ def main():
     signals = _SignalFlag()
     signals.install()
     try:
-        rospy.init_node(NODE_NAME, disable_signals=True)
-        params = rospy.get_param("~", {})
+        try:
+            rospy.init_node(NODE_NAME, disable_signals=True)
+            params = rospy.get_param("~", {})
+        except (rospy.ROSException, OSError):
+            if signals.received is None:
+                raise
+        if signals.received is not None:
+            return 0  # interrupted while rospy waited for the master: nothing was published
         try:
             config = TeleopConfig.from_mapping(params)
         except ConfigError as err:
@@ -77,6 +83,7 @@ def main():
                       "key_timeout %g s, limits %g m/s / %g rad/s", rospy.get_name(), out.topic,
                       config.speed, config.turn, config.repeat_rate, config.key_timeout,
                       config.speed_limit, config.turn_limit)
+        signals.loop_started()
         reason = _run(stdin, Teleop(config), out, odom, signals)
         rospy.signal_shutdown(reason)
         return 0
@@ -200,15 +207,17 @@ class _LatestOdom:
 
 
 class _SignalFlag:
-    """SIGINT/SIGTERM/SIGHUP handlers that only record the signal and wake the key wait.
+    """SIGINT/SIGTERM/SIGHUP handlers that record the signal and wake the key wait.
 
-    The handler raises nothing, so a signal cannot cut a publish or the terminal restore in half; the wake-up
-    pipe (``signal.set_wakeup_fd``) ends the ``select`` at once, so the final stop goes out without waiting
-    for the poll period.
+    In the key loop the handler raises nothing, so a signal cannot cut a publish or the terminal restore in
+    half; the wake-up pipe (``signal.set_wakeup_fd``) ends the ``select`` at once, so the final stop goes out
+    without waiting for the poll period. Before the loop, rospy may be retrying to reach the master, which
+    only ends on a ROS shutdown: then the handler requests one.
     """
 
     def __init__(self):
         self.received = None
+        self._in_loop = False
         self.fd = None
         self._write_fd = None
         self._previous = {}
@@ -234,6 +243,14 @@ class _SignalFlag:
             os.close(self.fd)
             self.fd = self._write_fd = None
 
+    def loop_started(self):
+        """From now on the key loop notices signals itself."""
+        self._in_loop = True
+
     def _handle(self, signum, _frame):
         if self.received is None:
             self.received = signum
+            if not self._in_loop:
+                # In this (main) thread, as rospy's own handler does: the retry loop holds rospy's topic
+                # lock (re-entrant), which a shutdown from another thread would wait for forever.
+                rospy.signal_shutdown(f"signal {signal.Signals(signum).name} during start-up")
