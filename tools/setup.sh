@@ -16,7 +16,9 @@ DEBS=(
   python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-std-msgs python3-std-srvs
   python3-tf2-msgs python3-rosgraph-msgs
   # tests
-  python3-pytest liburdfdom-tools iproute2 procps
+  python3-pytest liburdfdom-tools iproute2 procps python3-rosnode
+  # teleop.launch opens the teleop in its own terminal window
+  xterm
 )
 
 log() { printf '[setup] %s\n' "$*"; }

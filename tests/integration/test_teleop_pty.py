@@ -20,6 +20,7 @@ import unittest
 import xmlrpc.client
 
 import rosgraph
+import rosnode
 import rospy
 import rostest
 from geometry_msgs.msg import Twist
@@ -144,7 +145,8 @@ class TestTeleopPty(unittest.TestCase):
         self.attrs_before = termios.tcgetattr(self.slave)
         self.reader = PtyReader(self.master)
         self.reader.start()
-        name = f"teleop_key_{next(self.names)}"
+        self.last_name = next(self.names)
+        name = f"teleop_key_{self.last_name}"
         self.proc = subprocess.Popen(["rosrun", PKG, "teleop_key", f"__name:={name}", *args],
                                      stdin=self.slave, stdout=self.slave, stderr=self.slave,
                                      start_new_session=True, close_fds=True)
@@ -279,6 +281,18 @@ class TestTeleopPty(unittest.TestCase):
 
     def test_sigint_stops_robot_and_restores_terminal(self):
         self._signal_case(signal.SIGINT)
+
+    def test_ros_shutdown_request_stops_robot(self):
+        self.start()
+        name = f"/teleop_key_{self.last_name}"
+        self.press_and_expect("i", 1.0, 0.0)
+        before = len(self.msgs)
+        # `rosnode kill`: the node's XML-RPC shutdown, handled in a rospy thread, not the key loop.
+        self.assertEqual(rosnode.kill_nodes([name]), ([name], []))
+        self.assertEqual(self.wait_exit(), 0, self._output_tail())
+        self.assert_ends_with_one_zero(before)
+        self.assert_terminal_restored()
+        self.assertNotIn(b"Traceback", self.reader.output())
 
     def test_stdin_closed_stops_robot(self):
         self.start()

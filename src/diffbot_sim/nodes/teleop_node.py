@@ -59,36 +59,44 @@ def main():
     try:
         try:
             rospy.init_node(NODE_NAME, disable_signals=True)
-            params = rospy.get_param("~", {})
-        except (rospy.ROSException, OSError):
-            if signals.received is None:
-                raise
-        if signals.received is not None:
-            return 0  # interrupted while rospy waited for the master: nothing was published
-        try:
-            config = TeleopConfig.from_mapping(params)
+            config, out, odom = _setup()
         except ConfigError as err:
             rospy.logfatal(str(err))
             rospy.signal_shutdown("invalid parameter")
             return 2
-        for name in TeleopConfig.unknown(params):
-            rospy.logwarn("ignoring unknown parameter ~%s", name)
-        out = _Output(rospy.Publisher("cmd_vel", Twist, queue_size=1))
-        # Runs before rospy closes its topics on a shutdown request (e.g. `rosnode kill`), so the stop
-        # still reaches subscribers; when main() quits by itself it has sent the stop already.
-        rospy.on_shutdown(out.final_stop)
-        odom = _LatestOdom()
-        rospy.Subscriber("odom", Odometry, odom.store, queue_size=1)
-        rospy.loginfo("%s: publishing on %s; speed %g m/s, turn %g rad/s, repeat_rate %g Hz, "
-                      "key_timeout %g s, limits %g m/s / %g rad/s", rospy.get_name(), out.topic,
-                      config.speed, config.turn, config.repeat_rate, config.key_timeout,
-                      config.speed_limit, config.turn_limit)
+        except (rospy.ROSException, OSError):
+            if signals.received is None:
+                raise
+        if signals.received is not None:
+            return 0  # interrupted during start-up, e.g. while rospy waited for the master
         signals.loop_started()
         reason = _run(stdin, Teleop(config), out, odom, signals)
         rospy.signal_shutdown(reason)
         return 0
     finally:
         signals.uninstall()
+
+
+def _setup():
+    """Read the parameters and create the topics; returns ``(config, output, odom)``.
+
+    Raises:
+        ConfigError: a parameter is invalid.
+    """
+    params = rospy.get_param("~", {})
+    config = TeleopConfig.from_mapping(params)
+    for name in TeleopConfig.unknown(params):
+        rospy.logwarn("ignoring unknown parameter ~%s", name)
+    out = _Output(rospy.Publisher("cmd_vel", Twist, queue_size=1))
+    # Runs before rospy closes its topics on a shutdown request (e.g. `rosnode kill`), so the stop still
+    # reaches subscribers; when main() quits by itself it has sent the stop already.
+    rospy.on_shutdown(out.final_stop)
+    odom = _LatestOdom()
+    rospy.Subscriber("odom", Odometry, odom.store, queue_size=1)
+    rospy.loginfo("%s: publishing on %s; speed %g m/s, turn %g rad/s, repeat_rate %g Hz, key_timeout %g s, "
+                  "limits %g m/s / %g rad/s", rospy.get_name(), out.topic, config.speed, config.turn,
+                  config.repeat_rate, config.key_timeout, config.speed_limit, config.turn_limit)
+    return config, out, odom
 
 
 def _run(stdin, teleop, out, odom, signals):
