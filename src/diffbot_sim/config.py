@@ -183,6 +183,27 @@ def joint_state_config(model, block, drive):
     return cfg if cfg.joints else None
 
 
+def max_wheel_velocity(sim, model, drive):
+    """Cap on each drive wheel's joint velocity [rad/s]: ``~max_wheel_velocity`` if > 0, else the slowest
+    URDF ``<limit velocity>`` of the wheels when every wheel has one, else FALLBACK_MAX_WHEEL_VELOCITY."""
+    if sim.max_wheel_velocity > 0:
+        return sim.max_wheel_velocity
+    limits = [model.joints[j].velocity_limit for j in drive.left_joints + drive.right_joints]
+    if all(limits):
+        return min(limits)
+    return FALLBACK_MAX_WHEEL_VELOCITY
+
+
+def wheel_efforts(model, drive):
+    """Motor force limit [N·m] per drive wheel (left then right): the plugin's torque, which Gazebo applies
+    as the joint's fmax, capped by the URDF ``<limit effort>`` where the model gives one."""
+    efforts = []
+    for name in drive.left_joints + drive.right_joints:
+        limit = model.joints[name].effort_limit
+        efforts.append(min(drive.max_wheel_torque, limit) if limit else drive.max_wheel_torque)
+    return efforts
+
+
 def as_params(cfg):
     """The effective configuration as a flat dict of ROS-parameter-friendly values (None dropped)."""
     return {k: v for k, v in asdict(cfg).items() if v is not None}

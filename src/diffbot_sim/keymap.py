@@ -215,11 +215,6 @@ def _clamp(value, limit):
     return min(max(value, 0.0), limit)
 
 
-def yaw_from_quaternion(x, y, z, w):
-    """Yaw (rad, about +z, in (-pi, pi]) of a unit quaternion; roll and pitch are ignored."""
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
 def format_status(command: Command, speed: float, turn: float, pose=None) -> str:
     """The one status line: current command, the scale, and the pose when odometry is known.
 

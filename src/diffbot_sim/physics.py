@@ -5,7 +5,6 @@ worlds side by side) and is used from one thread. Robots are loaded from URDF te
 plain numbers, in URDF link frames (not PyBullet's centre-of-mass frames).
 """
 import contextlib
-import math
 import os
 import tempfile
 import xml.etree.ElementTree as ET
@@ -212,8 +211,3 @@ class Robot:
         for index in self.joint_index.values():
             pybullet.resetJointState(self.body, index, 0.0, 0.0, physicsClientId=self.client)
 
-
-def yaw_of(quaternion):
-    """Yaw [rad] of an (x, y, z, w) quaternion."""
-    x, y, z, w = quaternion
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))

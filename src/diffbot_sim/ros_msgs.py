@@ -4,7 +4,7 @@ Each call returns a new message: rospy's queued publishers serialize on another 
 object must never be refilled after ``publish()``. What is constant (frames, names, covariance) is computed
 once by the builder. Stamps are passed in (sim time, as a genpy/rospy Time).
 """
-from geometry_msgs.msg import TransformStamped
+from geometry_msgs.msg import TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
@@ -70,6 +70,21 @@ def joint_state(stamp, names, positions, velocities, efforts):
 
 def clock(stamp):
     return Clock(clock=stamp)
+
+
+def twist(linear, angular):
+    """A planar body command: linear.x [m/s], angular.z [rad/s]."""
+    msg = Twist()
+    msg.linear.x = linear
+    msg.angular.z = angular
+    return msg
+
+
+def twist_stamped(stamp, linear, angular):
+    msg = TwistStamped()
+    msg.header.stamp = stamp
+    msg.twist = twist(linear, angular)
+    return msg
 
 
 def twist_values(twist):

@@ -4,6 +4,7 @@ import os
 
 import pytest
 
+from diffbot_sim import config
 from diffbot_sim.config import (FALLBACK_MAX_WHEEL_VELOCITY, SimConfig, as_params, drive_config,
                                 joint_state_config, sim_config)
 from diffbot_sim.errors import ConfigError, ModelError
@@ -317,3 +318,31 @@ def test_sim_config_rejects(key, value):
     assert info.value.name == f"~{key}"
     if isinstance(value, float) and math.isnan(value):
         assert "finite" in str(info.value)
+
+
+# --- wheel limits resolved from params, URDF and fallback (config.max_wheel_velocity / wheel_efforts) ---
+
+def _seed_drive():
+    from diffbot_sim.description import load_file
+    from diffbot_sim.model import parse_urdf
+    from diffbot_sim.plugins import read_plugins
+    import os
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    model = parse_urdf(load_file(os.path.join(root, "urdf", "diffbot.urdf.xacro")))
+    return model, config.drive_config(model, read_plugins(model).diff_drive, {})
+
+
+def test_max_wheel_velocity_precedence():
+    model, drive = _seed_drive()
+    assert config.max_wheel_velocity(config.sim_config({}), model, drive) == 40.0  # URDF <limit velocity>
+    assert config.max_wheel_velocity(config.sim_config({"max_wheel_velocity": 12.5}), model, drive) == 12.5
+    model.joints["left_wheel_joint"].velocity_limit = None
+    assert config.max_wheel_velocity(config.sim_config({}), model, drive) == config.FALLBACK_MAX_WHEEL_VELOCITY
+
+
+def test_wheel_efforts_capped_by_urdf_limit():
+    model, drive = _seed_drive()
+    assert config.wheel_efforts(model, drive) == [30.0, 30.0]  # plugin torque 30, URDF effort 30
+    model.joints["right_wheel_joint"].effort_limit = 7.0
+    model.joints["left_wheel_joint"].effort_limit = None
+    assert config.wheel_efforts(model, drive) == [30.0, 7.0]

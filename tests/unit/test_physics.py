@@ -10,7 +10,8 @@ from diffbot_sim import physics
 from diffbot_sim.controller import DiffDriveController
 from diffbot_sim.model import parse_urdf
 from diffbot_sim.odometry import EncoderOdometry
-from diffbot_sim.physics import ROOT_PLACEHOLDER_MASS, World, prepare_urdf, yaw_of
+from diffbot_sim.kinematics import yaw_from_quaternion
+from diffbot_sim.physics import ROOT_PLACEHOLDER_MASS, World, prepare_urdf
 
 DT = 1.0 / 240.0
 R, S, TORQUE = 0.032, 0.2, 30.0
@@ -47,7 +48,7 @@ def run(world, seconds):
 
 def pose2d(robot):
     (x, y, _), orientation = robot.base_pose()
-    return x, y, yaw_of(orientation)
+    return x, y, yaw_from_quaternion(*orientation)
 
 
 def angle_diff(a, b):
@@ -109,7 +110,7 @@ def test_base_pose_right_after_load_is_spawn_pose(make_world, seed_urdf, seed_mo
     assert px == pytest.approx(x, abs=1e-3)
     assert py == pytest.approx(y, abs=1e-3)
     assert pz == pytest.approx(0.0, abs=1e-3)
-    assert abs(angle_diff(yaw_of(orientation), yaw)) < 1e-3
+    assert abs(angle_diff(yaw_from_quaternion(*orientation), yaw)) < 1e-3
     # PyBullet's own base frame is the centre of mass (base_link merged in, 7.6 cm up): base_pose converts
     com, _ = pybullet.getBasePositionAndOrientation(robot.body, physicsClientId=world.client)
     assert com[2] > 0.05
@@ -225,9 +226,9 @@ def test_two_worlds_are_independent(make_world, seed_urdf, seed_model):
     assert pose2d(b)[0] == pytest.approx(1.0, abs=2e-3)
 
 
-def test_yaw_of():
+def test_yaw_from_quaternion_matches_pybullet():
     for yaw in (0.0, 0.5, -2.0, 3.0):
-        assert yaw_of(pybullet.getQuaternionFromEuler((0.0, 0.0, yaw))) == pytest.approx(yaw, abs=1e-6)
+        assert yaw_from_quaternion(*pybullet.getQuaternionFromEuler((0.0, 0.0, yaw))) == pytest.approx(yaw, abs=1e-6)
 
 
 @pytest.mark.slow

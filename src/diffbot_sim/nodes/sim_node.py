@@ -39,7 +39,8 @@ from ..description import load_file, parse_args, resolve_meshes
 from ..errors import DiffbotSimError, ModelError
 from ..model import parse_urdf
 from ..odometry import EncoderOdometry
-from ..physics import World, yaw_of
+from ..kinematics import quaternion_from_yaw
+from ..physics import World
 from ..plugins import read_plugins
 from ..throttle import Throttle
 
@@ -109,25 +110,13 @@ class RobotRuntime:
     def _setup_drive(self, sync):
         drive, cfg, robot = self.drive, self.cfg, self.robot
         radius = drive.wheel_radius
-        limits = [robot.model.joints[j].velocity_limit for j in drive.left_joints + drive.right_joints]
-        if cfg.max_wheel_velocity > 0:
-            max_vel = cfg.max_wheel_velocity
-        elif all(v for v in limits):
-            max_vel = min(limits)
-        else:
-            max_vel = cfgmod.FALLBACK_MAX_WHEEL_VELOCITY
-        self.max_wheel_velocity = max_vel
-        self.controller = DiffDriveController(drive.wheel_separation, radius, max_vel,
+        self.max_wheel_velocity = cfgmod.max_wheel_velocity(cfg, robot.model, drive)
+        self.controller = DiffDriveController(drive.wheel_separation, radius, self.max_wheel_velocity,
                                               drive.max_wheel_acceleration, cfg.cmd_vel_timeout)
         self.left_idx = robot.indices(drive.left_joints)
         self.right_idx = robot.indices(drive.right_joints)
         self.wheel_idx = self.left_idx + self.right_idx
-        # Effort limit: the plugin's torque (Gazebo applies it as the joint's fmax), further capped by the
-        # URDF <limit effort> when the model gives one. Both are joint-side values.
-        self.wheel_forces = []
-        for jname in drive.left_joints + drive.right_joints:
-            limit = robot.model.joints[jname].effort_limit
-            self.wheel_forces.append(min(drive.max_wheel_torque, limit) if limit else drive.max_wheel_torque)
+        self.wheel_forces = cfgmod.wheel_efforts(robot.model, drive)
         self.update_period = 1.0 / drive.update_rate if drive.update_rate > 0 else 0.0
         self.next_update = 0.0
         self.last_update = 0.0
@@ -164,6 +153,10 @@ class RobotRuntime:
         self.sim.wake.set()
 
     def _on_joint_command(self, msg, joint):
+        """Subscriber thread: keep the newest finite command per joint (validated here, like cmd_vel)."""
+        if not math.isfinite(msg.data):
+            self.sim.warn(f"joint:{joint}", f"ignored a non-finite command for joint {joint}")
+            return
         with self._lock:
             self._joint_commands[joint] = msg.data
         self.sim.wake.set()
@@ -178,7 +171,7 @@ class RobotRuntime:
     def before_step(self, now, twist, joint_commands):
         """Apply new commands and run the controller when due. Called by the loop before each step."""
         for joint, value in joint_commands.items():
-            self._apply_joint_command(joint, value, now)
+            self._apply_joint_command(joint, value)
         if self.controller is None:
             return
         fresh = False
@@ -198,17 +191,11 @@ class RobotRuntime:
             if now + 1e-9 >= self.next_update:
                 self.next_update = _next_due(self.next_update, self.update_period, now)
             if fresh and self.debug_pub is not None:
-                out = TwistStamped()
-                out.header.stamp = rospy.Time.from_sec(time.time())
-                out.twist.linear.x, out.twist.angular.z = twist[0], twist[5]
-                self.debug_pub.publish(out)
+                self.debug_pub.publish(ros_msgs.twist_stamped(rospy.Time.from_sec(time.time()), twist[0], twist[5]))
 
-    def _apply_joint_command(self, joint, value, now):
+    def _apply_joint_command(self, joint, value):
         trans = self.motor_joints[joint]
         idx = self.robot.indices([joint])
-        if not (value == value and abs(value) != float("inf")):
-            self.sim.warn(f"joint:{joint}", f"ignored a non-finite command for joint {joint}")
-            return
         limit = self.model.joints[joint].effort_limit
         force = limit if limit else cfgmod.FALLBACK_JOINT_EFFORT
         if trans.interface == "VelocityJointInterface":
@@ -239,8 +226,7 @@ class RobotRuntime:
             self.encoder.update(positions[0], positions[1], now)
             enc = self.encoder
             position = (enc.x, enc.y, 0.0)
-            half = enc.yaw / 2.0
-            orientation = (0.0, 0.0, math.sin(half), math.cos(half))
+            orientation = quaternion_from_yaw(enc.yaw)
             linear, angular = (enc.linear, 0.0, 0.0), (0.0, 0.0, enc.angular)
         else:
             position, orientation = self.robot.base_pose()

@@ -33,7 +33,9 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
 from ..errors import ConfigError, TerminalError
-from ..keymap import BANNER, STOP, Teleop, TeleopConfig, format_status, yaw_from_quaternion
+from .. import ros_msgs
+from ..keymap import BANNER, STOP, Teleop, TeleopConfig, format_status
+from ..kinematics import yaw_from_quaternion
 from ..terminal import EOF, StatusLine, raw_terminal, read_key, require_tty
 
 NODE_NAME = "teleop_key"
@@ -165,10 +167,7 @@ class _Output:
                 rospy.logerr("could not publish the final stop on %s: %s", self.topic, err)
 
     def _publish(self, command):
-        msg = Twist()
-        msg.linear.x = command.linear
-        msg.angular.z = command.angular
-        self._pub.publish(msg)
+        self._pub.publish(ros_msgs.twist(command.linear, command.angular))
         self.last = command
         rospy.logdebug("publish x:%.3f, z:%.3f", command.linear, command.angular)
 
