@@ -20,6 +20,18 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RESULTS = os.path.join(ROOT, "test-results")
 
 
+def _why(element):
+    """The gist of a JUnit failure: its message, else the last line of its text (an assertion, usually)."""
+    text = (element.get("message") or "").strip()
+    body = (element.text or "").strip()
+    if body:
+        text = text or body.splitlines()[-1]
+        last = body.splitlines()[-1].strip()
+        if last not in text:
+            text = f"{text} | {last}"
+    return " ".join(text.split())[:400] or "(no message)"
+
+
 def count_junit(paths):
     """Return (passed, failed, skipped, failed_names) summed over JUnit XML files."""
     passed = failed = skipped = 0
@@ -33,9 +45,10 @@ def count_junit(paths):
             continue
         for case in root.iter("testcase"):
             name = f"{case.get('classname', '')}.{case.get('name', '')}"
-            if case.find("failure") is not None or case.find("error") is not None:
+            bad = case.find("failure") if case.find("failure") is not None else case.find("error")
+            if bad is not None:
                 failed += 1
-                names.append(name)
+                names.append(f"{name}: {_why(bad)}")
             elif case.find("skipped") is not None:
                 skipped += 1
             else:
