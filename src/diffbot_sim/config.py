@@ -81,6 +81,25 @@ class JointStateConfig:
     namespace: Optional[str] = None
 
 
+@dataclass
+class RobotSpec:
+    """One robot to spawn (an entry of ``~robots``, or the single robot of ``~model``/``~x``...).
+
+    A named robot lives in its own namespace, as ``spawn_model -robot_namespace`` puts a Gazebo robot:
+    its plugins' topics move under ``/<name>/`` and its frames get ``<tf_prefix>/`` (robot_state_publisher's
+    ``tf_prefix`` rule), so several copies of one model can share the world.
+    """
+
+    name: str = ""  # namespace; "" (single robot): the plugins' own namespaces and frames, unprefixed
+    model: str = ""  # .urdf/.urdf.xacro path; empty: /<name>/robot_description, else robot_description
+    model_args: str = ""  # xacro arguments, "name:=value ..."
+    x: float = 0.0  # m, spawn pose in the world
+    y: float = 0.0
+    z: float = 0.0
+    yaw: float = 0.0  # rad
+    tf_prefix: Optional[str] = None  # None: the name; "" : no prefix
+
+
 # ---------------------------------------------------------------------------------------------- builders
 
 def sim_config(params):
@@ -183,6 +202,76 @@ def joint_state_config(model, block, drive):
     return cfg if cfg.joints else None
 
 
+_ROBOT_KEYS = {f.name for f in fields(RobotSpec)}
+
+
+def robot_specs(sim, params):
+    """The robots to spawn: the ``~robots`` list when given, else one robot from ``~model``, ``~x``...
+
+    ``~robots`` entries are names (``robot1``) or dicts with RobotSpec's keys. Names must be distinct,
+    valid ROS names and poses distinct (two bodies spawned in one place explode apart).
+
+    Raises:
+        ConfigError: naming the entry and key at fault (``~robots[1].yaw``).
+    """
+    if "robots" not in params:
+        return [RobotSpec(model=sim.model, model_args=sim.model_args, x=sim.x, y=sim.y, z=sim.z, yaw=sim.yaw)]
+    entries = params["robots"]
+    if not isinstance(entries, (list, tuple)) or not entries:
+        raise ConfigError("~robots", entries, "a non-empty list of robot names or {name: ..., x: ...} dicts")
+    specs = []
+    for i, entry in enumerate(entries):
+        label = f"~robots[{i}]"
+        if isinstance(entry, str):
+            entry = {"name": entry}
+        if not isinstance(entry, dict):
+            raise ConfigError(label, entry, "a robot name or a dict with a 'name'")
+        unknown = sorted(set(entry) - _ROBOT_KEYS)
+        if unknown:
+            raise ConfigError(f"{label}.{unknown[0]}", entry[unknown[0]],
+                              f"one of the keys {', '.join(sorted(_ROBOT_KEYS))}")
+        spec = RobotSpec()
+        spec.name = _ros_name(f"{label}.name", entry.get("name"))
+        for key in ("model", "model_args"):
+            setattr(spec, key, _string(f"{label}.{key}", entry.get(key, ""), allow_empty=True))
+        for key in ("x", "y", "z", "yaw"):
+            setattr(spec, key, _number(f"{label}.{key}", entry.get(key, 0.0)))
+        if entry.get("tf_prefix") is not None:
+            spec.tf_prefix = _string(f"{label}.tf_prefix", entry["tf_prefix"], allow_empty=True).strip("/")
+        for j, other in enumerate(specs):
+            if other.name == spec.name:
+                raise ConfigError(f"{label}.name", spec.name, f"a name not already used by ~robots[{j}]")
+            if (other.x, other.y, other.z) == (spec.x, spec.y, spec.z):
+                raise ConfigError(label, entry, f"a spawn position other than that of ~robots[{j}] "
+                                  f"({other.x:g}, {other.y:g}, {other.z:g})")
+        specs.append(spec)
+    return specs
+
+
+def prefix_frame(prefix, frame):
+    """``prefix/frame`` as robot_state_publisher's tf_prefix forms it; the frame unchanged for no prefix."""
+    frame = frame.lstrip("/")
+    return f"{prefix.strip('/')}/{frame}" if prefix and prefix.strip("/") else frame
+
+
+def place_in_namespace(spec, drive, joint_cfg):
+    """Move a named robot's drive and joint-state endpoints under ``/<name>`` and prefix its frames.
+
+    The robot's namespace replaces the plugins' own, as gazebo_ros's spawner does; absolute topic names
+    (``/cmd_vel``) stay absolute, as they would in Gazebo. A no-op for the unnamed single robot.
+    """
+    if not spec.name:
+        return
+    namespace = "/" + spec.name
+    prefix = spec.name if spec.tf_prefix is None else spec.tf_prefix
+    if drive is not None:
+        drive.namespace = namespace
+        drive.odometry_frame = prefix_frame(prefix, drive.odometry_frame)
+        drive.robot_base_frame = prefix_frame(prefix, drive.robot_base_frame)
+    if joint_cfg is not None:
+        joint_cfg.namespace = namespace
+
+
 def max_wheel_velocity(sim, model, drive):
     """Cap on each drive wheel's joint velocity [rad/s]: ``~max_wheel_velocity`` if > 0, else the slowest
     URDF ``<limit velocity>`` of the wheels when every wheel has one, else FALLBACK_MAX_WHEEL_VELOCITY."""
@@ -253,6 +342,15 @@ def _number(name, value, low=None, high=None, low_open=False):
     if high is not None and number > high:
         raise ConfigError(name, value, f"a number <= {high:g}")
     return number
+
+
+def _ros_name(name, value):
+    """A relative ROS graph name for a namespace: letters, digits, ``_`` and ``/`` separators."""
+    text = value.strip().strip("/") if isinstance(value, str) else None
+    if not text or not all(part and part[0].isalpha() and all(c.isalnum() or c == "_" for c in part)
+                           for part in text.split("/")):
+        raise ConfigError(name, value, "a ROS name such as robot1 (a letter, then letters, digits or _)")
+    return text
 
 
 def _bool(name, value):

@@ -69,8 +69,11 @@ def _join(namespace, name):
 class RobotRuntime:
     """One robot: its physics body, controller, odometry and ROS endpoints."""
 
-    def __init__(self, sim, model, robot, drive, joint_cfg, cfg):
+    def __init__(self, sim, model, robot, drive, joint_cfg, cfg, spec):
         self.sim = sim
+        self.spec = spec
+        self.namespace = "/" + spec.name if spec.name else None
+        self.private = f"~{spec.name}/" if spec.name else "~"  # private topics: ~<name>/ground_truth
         self.model = model
         self.robot = robot
         self.drive = drive
@@ -100,7 +103,7 @@ class RobotRuntime:
             self.js_period = 1.0 / joint_cfg.update_rate if joint_cfg.update_rate > 0 else 0.0
         for joint, trans in self.motor_joints.items():
             suffix = _CONTROLLER_SUFFIX[trans.interface]
-            topic = f"{joint}_{suffix}_controller/command"
+            topic = _join(self.namespace, f"{joint}_{suffix}_controller/command")
             if trans.interface != "PositionJointInterface":
                 self.robot.free_joints(self.robot.indices([joint]))
             self.command_subs.append(rospy.Subscriber(topic, Float64, self._on_joint_command,
@@ -130,11 +133,11 @@ class RobotRuntime:
                                                      drive.covariance_x, drive.covariance_y, drive.covariance_yaw)
         self.truth_pub = None
         if cfg.publish_ground_truth:
-            self.truth_pub = _publisher("~ground_truth", Odometry, sync)
+            self.truth_pub = _publisher(self.private + "ground_truth", Odometry, sync)
             self.truth_builder = ros_msgs.OdometryBuilder("world", drive.robot_base_frame, 0.0, 0.0, 0.0)
         self.debug_pub = None
         if cfg.debug_cmd_applied:
-            self.debug_pub = _publisher("~debug/cmd_applied", TwistStamped, False)
+            self.debug_pub = _publisher(self.private + "debug/cmd_applied", TwistStamped, False)
 
     def _on_twist(self, msg):
         """Subscriber thread: keep the newest *valid* command; the loop applies it at its next step.
@@ -162,14 +165,18 @@ class RobotRuntime:
         self.sim.wake.set()
 
     def take_pending(self):
+        """The newest twist and joint commands since the last call (None, {} when there are none)."""
+        if self._pending_twist is None and not self._joint_commands:
+            return None, {}  # the common case, checked without the lock (attribute reads are atomic)
         with self._lock:
             twist, self._pending_twist = self._pending_twist, None
             joints, self._joint_commands = self._joint_commands, {}
         return twist, joints
 
     # -- loop work ----------------------------------------------------------------------------------
-    def before_step(self, now, twist, joint_commands):
+    def before_step(self, now):
         """Apply new commands and run the controller when due. Called by the loop before each step."""
+        twist, joint_commands = self.take_pending()
         for joint, value in joint_commands.items():
             self._apply_joint_command(joint, value)
         if self.controller is None:
@@ -177,21 +184,22 @@ class RobotRuntime:
         fresh = False
         if twist is not None:
             fresh = self.controller.set_command(twist[0], twist[5], now)
-        expiry = self.controller.expiry()
-        stale = expiry is not None and now >= expiry
-        if fresh or stale or now + 1e-9 >= self.next_update:
-            _, velocities, _ = self.robot.joint_states(self.wheel_idx)
-            n = len(self.left_idx)
-            left_v = sum(velocities[:n]) / n
-            right_v = sum(velocities[n:]) / n
-            dt = max(now - self.last_update, self.cfg.time_step)
-            left, right = self.controller.update(now, left_v, right_v, dt)
-            self.robot.set_velocities(self.wheel_idx, [left] * n + [right] * n, self.wheel_forces)
-            self.last_update = now
-            if now + 1e-9 >= self.next_update:
-                self.next_update = _next_due(self.next_update, self.update_period, now)
-            if fresh and self.debug_pub is not None:
-                self.debug_pub.publish(ros_msgs.twist_stamped(rospy.Time.from_sec(time.time()), twist[0], twist[5]))
+        elif now + 1e-9 < self.next_update:
+            expiry = self.controller.expiry()
+            if expiry is None or now < expiry:
+                return  # nothing new, nothing due: the motors keep their targets
+        _, velocities, _ = self.robot.joint_states(self.wheel_idx)
+        n = len(self.left_idx)
+        left_v = sum(velocities[:n]) / n
+        right_v = sum(velocities[n:]) / n
+        dt = max(now - self.last_update, self.cfg.time_step)
+        left, right = self.controller.update(now, left_v, right_v, dt)
+        self.robot.set_velocities(self.wheel_idx, [left] * n + [right] * n, self.wheel_forces)
+        self.last_update = now
+        if now + 1e-9 >= self.next_update:
+            self.next_update = _next_due(self.next_update, self.update_period, now)
+        if fresh and self.debug_pub is not None:
+            self.debug_pub.publish(ros_msgs.twist_stamped(rospy.Time.from_sec(time.time()), twist[0], twist[5]))
 
     def _apply_joint_command(self, joint, value):
         trans = self.motor_joints[joint]
@@ -205,17 +213,30 @@ class RobotRuntime:
         else:
             self.robot.set_efforts(idx, [max(-force, min(force, value))])
 
-    def after_step(self, now, stamp):
-        """Publish what is due at sim time ``now``. Called by the loop after each step."""
+    def next_publish(self):
+        """Sim time of this robot's next odom/TF or joint_states publication."""
+        due = [self.next_odom] if self.controller is not None else []
+        if self.joint_cfg is not None:
+            due.append(self.next_js)
+        return min(due) if due else math.inf
+
+    def next_due(self):
+        """Sim time of the next thing this robot must do (controller update, odom, joint_states)."""
+        update = self.next_update if self.controller is not None else math.inf
+        return min(update, self.next_publish())
+
+    def after_step(self, now, stamp, transforms):
+        """Publish what is due at sim time ``now``; TF transforms go into ``transforms`` (one TFMessage for
+        every robot is cheaper than one each). Called by the loop after each step."""
         if self.controller is not None and now + 1e-9 >= self.next_odom:
             self.next_odom = _next_due(self.next_odom, self.update_period, now)
-            self._publish_odometry(now, stamp)
+            self._publish_odometry(now, stamp, transforms)
         if self.joint_cfg is not None and now + 1e-9 >= self.next_js:
             self.next_js = _next_due(self.next_js, self.js_period, now)
             positions, velocities, efforts = self.robot.joint_states(self.js_indices)
             self.js_pub.publish(ros_msgs.joint_state(stamp, self.js_names, positions, velocities, efforts))
 
-    def _publish_odometry(self, now, stamp):
+    def _publish_odometry(self, now, stamp, transforms):
         drive = self.drive
         if self.truth_pub is not None:
             pose = self.robot.base_pose()
@@ -234,8 +255,8 @@ class RobotRuntime:
         if self.odom_pub is not None:
             self.odom_pub.publish(self.odom_builder.build(stamp, position, orientation, linear, angular))
         if drive.publish_odom_tf:
-            tf = ros_msgs.transform(stamp, drive.odometry_frame, drive.robot_base_frame, position, orientation)
-            self.sim.tf_pub.publish(ros_msgs.tf_message([tf]))
+            transforms.append(ros_msgs.transform(stamp, drive.odometry_frame, drive.robot_base_frame,
+                                                 position, orientation))
 
     def reset(self):
         """Brake and drop pending commands; the caller re-anchors the encoder (start_encoder)."""
@@ -280,6 +301,7 @@ class Simulator:
         self.robots = []
         self.clock_period = 1.0 / cfg.clock_rate
         self.next_clock = 0.0
+        self._next_publish = 0.0  # sim time of the earliest publication due, over clock and every robot
 
     def warn(self, key, text):
         """A throttled warning (wall time): at most one per key per 5 s, with a count of what was held back."""
@@ -351,9 +373,7 @@ class Simulator:
                 if self.sim_time + dt > target + 1e-9:
                     # Sleep until the next thing due (or a command wakes us). Publishing, not stepping,
                     # sets the wake rate, so CPU stays low while commands still apply within a step.
-                    due = min([self.next_clock] + [r.next_update for r in self.robots if r.controller]
-                              + [r.next_odom for r in self.robots if r.controller]
-                              + [r.next_js for r in self.robots if r.joint_cfg])
+                    due = min([self.next_clock] + [r.next_due() for r in self.robots])
                     wait = (max(due, self.sim_time + dt) - target) / cfg.real_time_factor
                     self.wake.wait(min(max(wait, 0.0), 0.1))
                     self.wake.clear()
@@ -363,16 +383,21 @@ class Simulator:
     def _step_once(self):
         now = self.sim_time
         for runtime in self.robots:
-            twist, joints = runtime.take_pending()
-            runtime.before_step(now, twist, joints)
+            runtime.before_step(now)
         self.world.step()
         self.steps += 1
         now = self.sim_time
+        if now + 1e-9 < self._next_publish:
+            return  # most steps publish nothing: skip building a stamp and asking every robot
         stamp = rospy.Time.from_sec(now)
+        transforms = []
         for runtime in self.robots:
-            runtime.after_step(now, stamp)
+            runtime.after_step(now, stamp, transforms)
+        if transforms:
+            self.tf_pub.publish(ros_msgs.tf_message(transforms))
         if now + 1e-9 >= self.next_clock:
             self._publish_clock(now)
+        self._next_publish = min([self.next_clock] + [r.next_publish() for r in self.robots])
 
     def _publish_clock(self, now):
         self.clock_pub.publish(ros_msgs.clock(rospy.Time.from_sec(now)))
@@ -382,64 +407,92 @@ class Simulator:
         self.world.close()
 
 
-def _load_model(cfg):
-    """URDF text and its source name, from ~model or else the robot_description parameter."""
-    if cfg.model:
-        path = os.path.abspath(os.path.expanduser(cfg.model))
-        return load_file(path, parse_args(cfg.model_args)), path
-    name = rospy.search_param("robot_description")
+def _load_model(spec):
+    """URDF text and its source name: the spec's file, else ``/<name>/robot_description``, else the
+    ``robot_description`` parameter found from the node's namespace (one model shared by every robot)."""
+    if spec.model:
+        path = os.path.abspath(os.path.expanduser(spec.model))
+        return load_file(path, parse_args(spec.model_args)), path
+    name = f"/{spec.name}/robot_description" if spec.name else None
+    if name is None or not rospy.has_param(name):
+        name = rospy.search_param("robot_description")
     if not name or not rospy.has_param(name):
-        raise ModelError("no ~model given and no robot_description parameter found", "robot_description")
+        raise ModelError("no ~model given and no robot_description parameter found",
+                         f"robot {spec.name}" if spec.name else "robot_description")
     text = rospy.get_param(name)
     if not isinstance(text, str) or not text.strip():
         raise ModelError("parameter is empty or not a string", name)
     return text, name
 
 
-def build(cfg, params):
-    """Load the model and build the simulator with its robot; raises DiffbotSimError on bad input."""
-    text, source = _load_model(cfg)
+class LoadedRobot:
+    """What build() learned about one robot, kept for the start-up report."""
+
+    def __init__(self, spec, model, plugins, drive, joint_cfg, runtime):
+        self.spec, self.model, self.plugins = spec, model, plugins
+        self.drive, self.joint_cfg, self.runtime = drive, joint_cfg, runtime
+
+
+def _build_robot(sim, cfg, spec, params):
+    text, source = _load_model(spec)
     model = parse_urdf(text, source)
     text = resolve_meshes(text, source)
     plugins = read_plugins(model)
     drive = cfgmod.drive_config(model, plugins.diff_drive, params)
     joint_cfg = cfgmod.joint_state_config(model, plugins.joint_state, drive)
+    cfgmod.place_in_namespace(spec, drive, joint_cfg)
     for trans in model.transmissions:
         model.joint(trans.joint, f"/robot/transmission[@name='{trans.name}']")
+    robot = sim.world.load_robot(text, model, (spec.x, spec.y, spec.z), spec.yaw)
+    runtime = RobotRuntime(sim, model, robot, drive, joint_cfg, cfg, spec)
+    sim.add_robot(runtime)
+    return LoadedRobot(spec, model, plugins, drive, joint_cfg, runtime)
+
+
+def build(cfg, params):
+    """Build the simulator with every robot of ``~robots`` (or the one robot); raises DiffbotSimError on
+    bad input, naming the robot's file, element or parameter."""
+    specs = cfgmod.robot_specs(cfg, params)
     sim = Simulator(cfg)
     try:
-        robot = sim.world.load_robot(text, model, (cfg.x, cfg.y, cfg.z), cfg.yaw)
-        runtime = RobotRuntime(sim, model, robot, drive, joint_cfg, cfg)
-    except Exception:
+        loaded = [_build_robot(sim, cfg, spec, params) for spec in specs]
+    except BaseException:
         sim.close()
         raise
-    sim.add_robot(runtime)
-    return sim, model, plugins, drive, joint_cfg
+    return sim, loaded
 
 
-def _report(cfg, model, plugins, drive, joint_cfg, sim):
+def _report(cfg, loaded):
     """Log the effective configuration once and write it back to the private parameters."""
-    for text in plugins.warnings:
-        rospy.logwarn(text)
-    if plugins.unsupported:
-        rospy.logwarn("not simulated (ignored): " + "; ".join(plugins.unsupported))
-    for block in (plugins.diff_drive, plugins.joint_state):
-        if block is not None and block.unknown_tags:
-            rospy.logwarn(f"{block.path}: unknown tags ignored: {', '.join(block.unknown_tags)}")
-    if drive is None:
-        rospy.logwarn("the model has no gazebo_ros_diff_drive plugin (and no ~left_joints): nothing "
-                      "subscribes cmd_vel")
-    params = cfgmod.as_params(cfg)
-    if drive is not None:
-        params.update(cfgmod.as_params(drive))
-        params["wheel_radius"] = drive.wheel_radius
-        params["effective_max_wheel_velocity"] = sim.robots[0].max_wheel_velocity
-    params["loaded_mass"] = sim.robots[0].robot.total_mass()
-    params["urdf_mass"] = model.total_mass()
-    for key, value in params.items():
+    for key, value in cfgmod.as_params(cfg).items():
         rospy.set_param("~" + key, value)
-    summary = ", ".join(f"{k}={v}" for k, v in sorted(params.items()))
-    rospy.loginfo(f"bullet_sim: model {model.source} ({model.name}); {summary}")
+    for item in loaded:
+        plugins, drive, model = item.plugins, item.drive, item.model
+        who = f"robot {item.spec.name}: " if item.spec.name else ""
+        for text in plugins.warnings:
+            rospy.logwarn(who + text)
+        if plugins.unsupported:
+            rospy.logwarn(who + "not simulated (ignored): " + "; ".join(plugins.unsupported))
+        for block in (plugins.diff_drive, plugins.joint_state):
+            if block is not None and block.unknown_tags:
+                rospy.logwarn(f"{who}{block.path}: unknown tags ignored: {', '.join(block.unknown_tags)}")
+        if drive is None:
+            rospy.logwarn(who + "the model has no gazebo_ros_diff_drive plugin (and no ~left_joints): nothing "
+                          "subscribes cmd_vel")
+        params = {}
+        if drive is not None:
+            params.update(cfgmod.as_params(drive))
+            params["wheel_radius"] = drive.wheel_radius
+            params["effective_max_wheel_velocity"] = item.runtime.max_wheel_velocity
+        params["loaded_mass"] = item.runtime.robot.total_mass()
+        params["urdf_mass"] = model.total_mass()
+        if item.spec.name:
+            params.update({k: v for k, v in cfgmod.as_params(item.spec).items() if k != "name"})
+        for key, value in params.items():
+            rospy.set_param(item.runtime.private + key, value)
+        params.update(cfgmod.as_params(cfg))
+        summary = ", ".join(f"{k}={v}" for k, v in sorted(params.items()))
+        rospy.loginfo(f"bullet_sim: {who}model {model.source} ({model.name}); {summary}")
 
 
 def main(argv=None):
@@ -451,13 +504,13 @@ def main(argv=None):
         if cfg.gui and not os.environ.get("DISPLAY"):
             rospy.logwarn("~gui is true but there is no display (DISPLAY unset): running headless (DIRECT)")
             cfg.gui = False
-        sim, model, plugins, drive, joint_cfg = build(cfg, params)
+        sim, loaded = build(cfg, params)
     except DiffbotSimError as err:
         rospy.logfatal(f"bullet_sim: {err}")
         rospy.signal_shutdown("bad input")
         return 1
     try:
-        _report(cfg, model, plugins, drive, joint_cfg, sim)
+        _report(cfg, loaded)
         sim.advertise_services()
         sim.run()
     finally:
