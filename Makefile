@@ -3,7 +3,7 @@ SHELL := /bin/bash
 ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
 ENV := $(ROOT)/tools/rosenv.sh
 
-.PHONY: setup run test test-slow unit clean
+.PHONY: setup run test test-slow unit bench clean
 
 setup:
 	@bash $(ROOT)/tools/setup.sh
@@ -17,9 +17,13 @@ test: setup
 test-slow: setup
 	@bash $(ENV) python3 $(ROOT)/tools/run_tests.py --slow
 
+# Speed, latency, start-up and scale figures (tools/bench.py; ~6 min; writes bench-results/bench.json).
+bench: setup
+	@bash $(ENV) python3 $(ROOT)/tools/bench.py
+
 unit: setup
 	@bash $(ENV) python3 -m pytest -q $(ROOT)/tests/unit
 
 
 clean:
-	rm -rf $(ROOT)/catkin_ws/build $(ROOT)/catkin_ws/devel $(ROOT)/catkin_ws/src $(ROOT)/test-results
+	rm -rf $(ROOT)/catkin_ws/build $(ROOT)/catkin_ws/devel $(ROOT)/catkin_ws/src $(ROOT)/test-results $(ROOT)/bench-results

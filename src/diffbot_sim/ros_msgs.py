@@ -1,14 +1,31 @@
 """The only place message objects are built (message modules only; no rospy).
 
-Each call returns a new message: rospy's queued publishers serialize on another thread later, so a message
-object must never be refilled after ``publish()``. What is constant (frames, names, covariance) is computed
-once by the builder. Stamps are passed in (sim time, as a genpy/rospy Time).
+The simulator publishes four messages per control period, thousands per wall second in fast mode, so its
+builders reuse one message object each and serialize it with a few precompiled ``struct`` calls instead of
+genpy's field-by-field code. That is safe because rospy serializes inside ``publish()`` on the caller's
+thread, queued publisher or not (rospy/topics.py ``_PublisherImpl.publish``): once ``publish()`` returns,
+the object may be refilled. The packed classes keep their genpy type and md5sum and write the very same
+bytes (tests/unit/test_ros_msgs.py compares them with genpy's own ``serialize``); what never changes
+(frames, joint names, covariance) is packed once per builder. The subclasses declare no ``__slots__`` on
+purpose: genpy reads ``self.__slots__`` for the field list (printing, equality, keyword construction).
 """
+import struct
+
 from geometry_msgs.msg import TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
+
+_HEADER = struct.Struct("<3I")  # seq, stamp.secs, stamp.nsecs
+_COUNT = struct.Struct("<I")
+_POSE = struct.Struct("<7d")  # position xyz, orientation xyzw
+_TWIST = struct.Struct("<6d")  # linear xyz, angular xyz
+
+
+def _string(text):
+    data = text.encode("utf-8")
+    return _COUNT.pack(len(data)) + data
 
 
 def covariance_diagonal(cov_x, cov_y, cov_yaw):
@@ -19,53 +36,138 @@ def covariance_diagonal(cov_x, cov_y, cov_yaw):
     return cov
 
 
+class PackedOdometry(Odometry):
+    """nav_msgs/Odometry with frames and covariance packed once (same type, md5sum and bytes)."""
+
+
+    def __init__(self, frame, child, covariance):
+        super().__init__()
+        self.header.frame_id, self.child_frame_id = frame, child
+        self.pose.covariance = self.twist.covariance = list(covariance)
+        self._frames = _string(frame) + _string(child)
+        self._covariance = struct.pack("<36d", *covariance)
+
+    def serialize(self, buff):
+        h, p, t = self.header, self.pose.pose, self.twist.twist
+        buff.write(_HEADER.pack(h.seq, h.stamp.secs, h.stamp.nsecs))
+        buff.write(self._frames)
+        a, b = p.position, p.orientation
+        buff.write(_POSE.pack(a.x, a.y, a.z, b.x, b.y, b.z, b.w))
+        buff.write(self._covariance)
+        a, b = t.linear, t.angular
+        buff.write(_TWIST.pack(a.x, a.y, a.z, b.x, b.y, b.z))
+        buff.write(self._covariance)
+
+
 class OdometryBuilder:
     """Odometry in ``frame`` for ``child``: pose in the odometry frame, twist in the child frame (signed)."""
 
     def __init__(self, frame, child, cov_x, cov_y, cov_yaw):
         self.frame, self.child = frame, child
         self.covariance = covariance_diagonal(cov_x, cov_y, cov_yaw)
+        self.msg = PackedOdometry(frame, child, self.covariance)
 
     def build(self, stamp, position, orientation, linear, angular):
-        msg = Odometry()
+        """The builder's message, refilled: publish it before the next build()."""
+        msg = self.msg
         msg.header.stamp = stamp
-        msg.header.frame_id = self.frame
-        msg.child_frame_id = self.child
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
         p.x, p.y, p.z = position
         q.x, q.y, q.z, q.w = orientation
         v, w = msg.twist.twist.linear, msg.twist.twist.angular
         v.x, v.y, v.z = linear
         w.x, w.y, w.z = angular
-        msg.pose.covariance = self.covariance
-        msg.twist.covariance = self.covariance
         return msg
 
 
+class PackedTransformStamped(TransformStamped):
+    """geometry_msgs/TransformStamped with its two frames packed once."""
+
+
+    def __init__(self, frame, child):
+        super().__init__()
+        self.header.frame_id, self.child_frame_id = frame, child
+        self._frames = _string(frame) + _string(child)
+
+    def serialize(self, buff):
+        h, t = self.header, self.transform
+        buff.write(_HEADER.pack(h.seq, h.stamp.secs, h.stamp.nsecs))
+        buff.write(self._frames)
+        a, b = t.translation, t.rotation
+        buff.write(_POSE.pack(a.x, a.y, a.z, b.x, b.y, b.z, b.w))
+
+
+class TransformBuilder:
+    """One frame pair's transform, refilled per build (publish it before the next build)."""
+
+    def __init__(self, frame, child):
+        self.msg = PackedTransformStamped(frame, child)
+
+    def build(self, stamp, position, orientation):
+        msg = self.msg
+        msg.header.stamp = stamp
+        t, r = msg.transform.translation, msg.transform.rotation
+        t.x, t.y, t.z = position
+        r.x, r.y, r.z, r.w = orientation
+        return msg
+
+
+class PackedTFMessage(TFMessage):
+    """tf2_msgs/TFMessage that lets each transform write itself (packed ones write in two calls)."""
+
+
+    def serialize(self, buff):
+        buff.write(_COUNT.pack(len(self.transforms)))
+        for transform in self.transforms:
+            transform.serialize(buff)
+
+
 def transform(stamp, frame, child, position, orientation):
-    msg = TransformStamped()
-    msg.header.stamp = stamp
-    msg.header.frame_id = frame
-    msg.child_frame_id = child
-    t, r = msg.transform.translation, msg.transform.rotation
-    t.x, t.y, t.z = position
-    r.x, r.y, r.z, r.w = orientation
-    return msg
+    """A new transform (for one-off use; the simulator loop uses TransformBuilder)."""
+    return TransformBuilder(frame, child).build(stamp, position, orientation)
 
 
 def tf_message(transforms):
     """All of a step's transforms in one TFMessage (one publish, not one per frame)."""
-    return TFMessage(transforms=list(transforms))
+    return PackedTFMessage(transforms=list(transforms))
+
+
+class PackedJointState(JointState):
+    """sensor_msgs/JointState for a fixed list of joints, names packed once."""
+
+
+    def __init__(self, names):
+        super().__init__()
+        self.name = list(names)
+        self._names = _COUNT.pack(len(names)) + b"".join(_string(n) for n in names)
+        self._array = struct.Struct(f"<I{len(names)}d")
+
+    def serialize(self, buff):
+        h, n, array = self.header, len(self.name), self._array
+        if len(self.position) != n or len(self.velocity) != n or len(self.effort) != n:
+            return JointState.serialize(self, buff)
+        buff.write(_HEADER.pack(h.seq, h.stamp.secs, h.stamp.nsecs))
+        buff.write(_string(h.frame_id))
+        buff.write(self._names)
+        buff.write(array.pack(n, *self.position))
+        buff.write(array.pack(n, *self.velocity))
+        buff.write(array.pack(n, *self.effort))
+
+
+class JointStateBuilder:
+    def __init__(self, names):
+        self.msg = PackedJointState(names)
+
+    def build(self, stamp, positions, velocities, efforts):
+        msg = self.msg
+        msg.header.stamp = stamp
+        msg.position, msg.velocity, msg.effort = positions, velocities, efforts
+        return msg
 
 
 def joint_state(stamp, names, positions, velocities, efforts):
-    msg = JointState()
-    msg.header.stamp = stamp
-    msg.name = names
-    msg.position = positions
-    msg.velocity = velocities
-    msg.effort = efforts
-    return msg
+    """A new JointState (one-off use; the simulator loop uses JointStateBuilder)."""
+    return JointStateBuilder(names).build(stamp, positions, velocities, efforts)
 
 
 def clock(stamp):

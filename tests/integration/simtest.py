@@ -3,6 +3,7 @@
 Callbacks only record; the test thread asserts. Waits poll a predicate against a wall-clock deadline.
 """
 import math
+import os
 import threading
 import time
 
@@ -140,3 +141,58 @@ def reset_robot(rec):
         return (msg.header.stamp.to_sec() > after and abs(p.x) < 0.01 and abs(p.y) < 0.01
                 and abs(msg.twist.twist.linear.x) < 0.01 and abs(msg.twist.twist.angular.z) < 0.01)
     rec.wait(at_rest, 20.0, "the robot at rest at the origin after reset")
+
+
+# -- helpers for the reliability suites (flood, soak, signals) -------------------------------------------
+
+def node_pid(node, caller="/simtest_pid"):
+    """The pid of a registered node, asked over its own XML-RPC API (getPid), never by process name."""
+    import xmlrpc.client
+
+    import rosgraph
+    uri = rosgraph.Master(caller).lookupNode(node)
+    code, msg, pid = xmlrpc.client.ServerProxy(uri).getPid(caller)
+    if code != 1:
+        raise AssertionError(f"getPid of {node} failed: {msg}")
+    return pid
+
+
+def rss_kib(pid):
+    """Resident set size of ``pid`` in KiB (VmRSS of /proc/<pid>/status); raises if the process is gone."""
+    with open(f"/proc/{pid}/status") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1])
+    raise AssertionError(f"no VmRSS for pid {pid} (a zombie?)")
+
+
+def alive(pid):
+    """True while ``pid`` exists and is not a zombie."""
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            return stat.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def figure(text):
+    """A measured figure: one ``FIGURE`` line in the test's log (rosout) and on its stdout."""
+    rospy.loginfo("FIGURE " + text)
+    print("FIGURE " + text, flush=True)
+
+
+def session_pids(sid):
+    """Pids of the live (non-zombie) processes in session ``sid`` (a process started with
+    ``start_new_session=True`` leads the session numbered by its pid; its children stay in it)."""
+    found = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat") as stat:
+                fields = stat.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if fields[0] != "Z" and int(fields[3]) == sid:  # state, ppid, pgrp, session
+            found.append(int(entry))
+    return found

@@ -1,0 +1,440 @@
+#!/usr/bin/env python3
+"""``make bench``: speed, latency, start-up and scale of bullet_sim, measured on the seed robot.
+
+Plain Python + the ROS CLI, no timing assertions: it prints a table and writes bench-results/bench.json.
+Every measurement starts its own master (``roslaunch -p PORT``) and stops it with SIGINT, so nothing is
+shared between items. ROS-side probes (``--probe ...``) run in child processes, one ROS node each.
+
+Items (issue 4):
+  fast       fast mode, every standard topic subscribed by its own process: RTF; bare PyBullet RTF
+             (same model, same step, same run) and the ratio.
+  realtime   real-time mode for 60 s: RTF error, simulator CPU (% of one core), /odom period jitter.
+  latency    cmd_vel published -> wheel motor target applied (~debug/cmd_applied), wall ms, at RTF 1.
+  startup    `roslaunch diffbot_sim sim.launch` -> first /odom, median of 5.
+  scale      namespaced seed robots one simulator keeps at RTF >= 1, all topics subscribed.
+"""
+import argparse
+import json
+import os
+import signal
+import socket
+import statistics
+import subprocess
+import sys
+import time
+import warnings
+import xml.etree.ElementTree as ET
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+RESULTS = os.path.join(ROOT, "bench-results")
+MODEL = os.path.join(ROOT, "urdf", "diffbot.urdf.xacro")
+STEP = 1.0 / 240.0
+TOPICS = ["/clock", "/odom", "/joint_states", "/tf"]
+
+
+# ------------------------------------------------------------------------------------------------ helpers
+
+def free_port():
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def percentile(values, q):
+    ordered = sorted(values)
+    if not ordered:
+        return float("nan")
+    k = min(len(ordered) - 1, max(0, int(round(q / 100.0 * (len(ordered) - 1)))))
+    return ordered[k]
+
+
+class Launch:
+    """``roslaunch -p PORT ...`` with its own master; stopped with SIGINT (then SIGKILL) on exit."""
+
+    def __init__(self, args, log_name):
+        self.port = free_port()
+        self.env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{self.port}",
+                        ROS_HOME=os.path.join(RESULTS, "ros_home"))
+        self.args = ["roslaunch", "-p", str(self.port)] + list(args)
+        self.log_path = os.path.join(RESULTS, f"{log_name}.log")
+        self.proc = None
+        self.children = []
+
+    def __enter__(self):
+        os.makedirs(RESULTS, exist_ok=True)
+        self.log = open(self.log_path, "w")
+        self.started = time.time()
+        self.proc = subprocess.Popen(self.args, env=self.env, stdout=self.log, stderr=subprocess.STDOUT,
+                                     stdin=subprocess.DEVNULL, start_new_session=True)
+        return self
+
+    def spawn(self, argv):
+        """A helper process (a subscriber) against this launch's master; stopped with SIGINT on exit."""
+        proc = subprocess.Popen(argv, env=self.env, stdout=subprocess.PIPE, stderr=self.log,
+                                stdin=subprocess.DEVNULL, text=True)
+        self.children.append(proc)
+        return proc
+
+    def probe(self, kind, timeout=300, **options):
+        """Run ``bench.py --probe kind`` against this master and return its JSON answer."""
+        argv = [sys.executable, os.path.abspath(__file__), "--probe", kind, "--options", json.dumps(options)]
+        out = subprocess.run(argv, env=self.env, stdout=subprocess.PIPE, stderr=self.log, text=True,
+                             timeout=timeout, stdin=subprocess.DEVNULL)
+        lines = [line for line in out.stdout.splitlines() if line.startswith("{")]
+        if out.returncode != 0 or not lines:
+            raise RuntimeError(f"probe {kind} failed (exit {out.returncode}); see {self.log_path}")
+        return json.loads(lines[-1])
+
+    def stop_children(self):
+        counts = []
+        for proc in self.children:
+            proc.send_signal(signal.SIGINT)
+        for proc in self.children:
+            try:
+                out, _ = proc.communicate(timeout=10)
+                counts.append(json.loads(out.strip().splitlines()[-1]) if out.strip() else None)
+            except (subprocess.TimeoutExpired, ValueError, IndexError):
+                proc.kill()
+                counts.append(None)
+        self.children = []
+        return counts
+
+    def __exit__(self, *exc):
+        self.stop_children()
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGINT)
+            try:
+                self.proc.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+                self.proc.wait()
+        self.log.close()
+
+
+def subscriber(launch, topics):
+    """A separate process subscribing ``topics`` (as `rostopic echo` would, without printing)."""
+    return launch.spawn([sys.executable, os.path.abspath(__file__), "--probe", "count",
+                         "--options", json.dumps({"topics": topics})])
+
+
+def sim_args(*extra):
+    return ["diffbot_sim", "sim.launch"] + list(extra)
+
+
+# ------------------------------------------------------------------------------------------------- probes
+# Each runs in its own process, as one ROS node, and prints one JSON line.
+
+def _sim_pid():
+    import rosnode
+    import xmlrpc.client
+    uri = rosnode.get_api_uri(rosnode.rosgraph.Master("/bench"), "/bullet_sim", skip_cache=True)
+    return xmlrpc.client.ServerProxy(uri).getPid("/bench")[2]
+
+
+def _cpu_seconds(pid):
+    with open(f"/proc/{pid}/stat") as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _wait(predicate, timeout, what):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return
+        time.sleep(0.01)
+    raise RuntimeError(f"timed out waiting for {what}")
+
+
+def probe_count(options):
+    """Subscribe (AnyMsg: no deserialisation, like `rostopic hz`) and print the count on SIGINT."""
+    import rospy
+    rospy.init_node("bench_sub", anonymous=True, disable_signals=True)
+    counts = {topic: 0 for topic in options["topics"]}
+
+    def keep(_msg, topic):
+        counts[topic] += 1
+    subs = [rospy.Subscriber(t, rospy.AnyMsg, keep, callback_args=t, queue_size=100) for t in counts]
+    stop = []
+    signal.signal(signal.SIGINT, lambda *_: stop.append(1))
+    while not stop:
+        time.sleep(0.05)
+    for sub in subs:
+        sub.unregister()
+    print(json.dumps(counts), flush=True)
+
+
+def probe_rtf(options):
+    """RTF from /clock over a window after a warm-up; simulator CPU; /odom receipt-period percentiles."""
+    import rospy
+    from geometry_msgs.msg import Twist
+    from nav_msgs.msg import Odometry
+    from rosgraph_msgs.msg import Clock
+    rospy.init_node("bench_rtf", disable_signals=True)
+    clock, odom = [], []
+    rospy.Subscriber("/clock", Clock, lambda m: clock.append((time.monotonic(), m.clock.to_sec())),
+                     queue_size=1000)
+    if options.get("odom_jitter"):
+        rospy.Subscriber(options.get("odom", "/odom"), Odometry, lambda m: odom.append(time.monotonic()),
+                         queue_size=1000)
+    _wait(lambda: len(clock) > 2, 60, "/clock")
+    pubs = [rospy.Publisher(f"{ns}/cmd_vel", Twist, queue_size=1, latch=True)
+            for ns in options.get("namespaces", [""])]
+    circle = Twist()
+    circle.linear.x, circle.angular.z = 0.2, 0.5
+    for pub in pubs:  # drive in circles: wheels, casters and contacts all busy
+        pub.publish(circle)
+    time.sleep(options.get("warmup", 3.0))
+    pid = _sim_pid()
+    cpu0, n0 = _cpu_seconds(pid), len(clock)
+    time.sleep(options["seconds"])
+    cpu1, n1 = _cpu_seconds(pid), len(clock)
+    (w0, s0), (w1, s1) = clock[n0 - 1], clock[n1 - 1]
+    result = {"rtf": (s1 - s0) / (w1 - w0), "cpu_percent": 100.0 * (cpu1 - cpu0) / (w1 - w0),
+              "wall_s": w1 - w0, "sim_s": s1 - s0}
+    if options.get("odom_jitter"):
+        stamps = [t for t in odom if w0 <= t <= w1]
+        periods = [1000.0 * (b - a) for a, b in zip(stamps, stamps[1:])]
+        nominal = 1000.0 / options["odom_rate"]
+        result.update({"odom_period_p50_ms": percentile(periods, 50), "odom_period_p99_ms": percentile(periods, 99),
+                       "odom_jitter_p99_ms": percentile([abs(p - nominal) for p in periods], 99),
+                       "odom_messages": len(stamps)})
+    print(json.dumps(result), flush=True)
+
+
+def probe_latency(options):
+    """cmd_vel publish (wall) -> ~debug/cmd_applied stamp (wall, set when the motor targets were set)."""
+    import rospy
+    from geometry_msgs.msg import Twist, TwistStamped
+    rospy.init_node("bench_latency", disable_signals=True)
+    applied = {}
+    rospy.Subscriber("/bullet_sim/debug/cmd_applied", TwistStamped,
+                     lambda m: applied.setdefault(round(m.twist.linear.x, 6), m.header.stamp.to_sec()),
+                     queue_size=1000)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # rospy warns on queue_size=None, which we mean
+        pub = rospy.Publisher("/cmd_vel", Twist, queue_size=None)  # synchronous: sent when publish returns
+    _wait(lambda: pub.get_num_connections() > 0, 30, "the simulator to subscribe /cmd_vel")
+    time.sleep(1.0)
+    sent = {}
+    for i in range(options["count"]):
+        value = round(0.05 + 0.0001 * i, 6)  # distinct, small: the robot creeps forward
+        msg = Twist()
+        msg.linear.x = value
+        sent[value] = time.time()
+        pub.publish(msg)
+        time.sleep(1.0 / options["rate"])
+    _wait(lambda: len(applied) >= len(sent) - 2, 10, "the last commands to be applied")
+    lat = [1000.0 * (applied[v] - t) for v, t in sent.items() if v in applied]
+    print(json.dumps({"p50_ms": percentile(lat, 50), "p99_ms": percentile(lat, 99), "max_ms": max(lat),
+                      "commands": len(sent), "applied": len(lat)}), flush=True)
+
+
+def probe_first_odom(options):
+    """Wall time (epoch) of the first /odom message; started before the master exists."""
+    import rosgraph
+    master = rosgraph.Master("/bench_first_odom")
+    _wait(master.is_online, 60, "the master")
+    import rospy
+    from nav_msgs.msg import Odometry
+    rospy.init_node("bench_first_odom", disable_signals=True)
+    first = []
+    rospy.Subscriber("/odom", Odometry, lambda m: first or first.append(time.time()), queue_size=1)
+    _wait(lambda: first, 60, "the first /odom")
+    print(json.dumps({"first_odom_epoch": first[0]}), flush=True)
+
+
+PROBES = {"count": probe_count, "rtf": probe_rtf, "latency": probe_latency, "first_odom": probe_first_odom}
+
+
+# -------------------------------------------------------------------------------------------------- items
+
+def bench_bare(seconds):
+    """The same model (xacro'd, loaded the way bullet_sim loads it) stepped by PyBullet alone."""
+    import pybullet
+    sys.path.insert(0, os.path.join(ROOT, "src"))
+    from diffbot_sim.description import load_file
+    from diffbot_sim.model import parse_urdf
+    from diffbot_sim.physics import World
+    text = load_file(MODEL)
+    model = parse_urdf(text, MODEL)
+    world = World(STEP)
+    try:
+        robot = world.load_robot(text, model)
+        wheels = robot.indices(["left_wheel_joint", "right_wheel_joint"])
+        robot.set_velocities(wheels, [5.0, 8.0], [30.0, 30.0])
+        client = world.client
+        for _ in range(240):
+            pybullet.stepSimulation(physicsClientId=client)
+        steps, start = 0, time.perf_counter()
+        while time.perf_counter() - start < seconds:
+            for _ in range(240):
+                pybullet.stepSimulation(physicsClientId=client)
+            steps += 240
+        elapsed = time.perf_counter() - start
+    finally:
+        world.close()
+    return {"steps_per_s": steps / elapsed, "rtf": steps * STEP / elapsed}
+
+
+def bench_fast(seconds):
+    with Launch(sim_args("real_time:=false"), "fast") as launch:
+        for topic in TOPICS[1:]:  # /clock is subscribed by the RTF probe itself, a process of its own
+            subscriber(launch, [topic])
+        result = launch.probe("rtf", seconds=seconds, warmup=3.0)
+        counts = launch.stop_children()
+    result["subscriber_messages"] = {k: v for c in counts if c for k, v in c.items()}
+    return result
+
+
+def bench_realtime(seconds):
+    with Launch(sim_args(), "realtime") as launch:
+        for topic in ("/joint_states", "/tf"):
+            subscriber(launch, [topic])
+        result = launch.probe("rtf", seconds=seconds, warmup=3.0, odom_jitter=True, odom_rate=100.0,
+                              timeout=seconds + 120)
+    result["rtf_error_percent"] = 100.0 * abs(result["rtf"] - 1.0)
+    return result
+
+
+def bench_latency(count):
+    with Launch(sim_args("debug_cmd_applied:=true"), "latency") as launch:
+        return launch.probe("latency", count=count, rate=20.0, timeout=count / 20.0 + 120)
+
+
+def bench_startup(runs):
+    times = []
+    for i in range(runs):
+        port = free_port()
+        env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}", ROS_HOME=os.path.join(RESULTS, "ros_home"))
+        probe = subprocess.Popen([sys.executable, os.path.abspath(__file__), "--probe", "first_odom", "--options", "{}"],
+                                 env=env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        time.sleep(0.5)  # the probe is up and polling for the master before the clock starts
+        start = time.time()
+        with open(os.path.join(RESULTS, f"startup{i}.log"), "w") as log:
+            proc = subprocess.Popen(["roslaunch", "-p", str(port)] + sim_args(), env=env, stdout=log,
+                                    stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, start_new_session=True)
+            try:
+                out, _ = probe.communicate(timeout=90)
+                times.append(json.loads(out.strip().splitlines()[-1])["first_odom_epoch"] - start)
+            finally:
+                proc.send_signal(signal.SIGINT)
+                try:
+                    proc.wait(timeout=20)
+                except subprocess.TimeoutExpired:
+                    os.killpg(proc.pid, signal.SIGKILL)
+                    proc.wait()
+    return {"median_s": statistics.median(times), "runs_s": times}
+
+
+def scale_launch(count, real_time):
+    """A launch file for ``count`` namespaced seed robots on a 1 m grid, each with robot_state_publisher."""
+    root = ET.Element("launch")
+    ET.SubElement(root, "param", name="use_sim_time", value="true")
+    ET.SubElement(root, "param", name="robot_description", command=f"xacro '{MODEL}'")
+    node = ET.SubElement(root, "node", name="bullet_sim", pkg="diffbot_sim", type="bullet_sim", required="true")
+    ET.SubElement(node, "param", name="real_time", value=str(real_time).lower())
+    robots = [{"name": f"robot{i + 1}", "x": float(i % 10), "y": float(i // 10)} for i in range(count)]
+    ET.SubElement(node, "rosparam", param="robots").text = json.dumps(robots)
+    for robot in robots:
+        inc = ET.SubElement(root, "include", file=os.path.join(ROOT, "launch", "robot_state.launch"), ns=robot["name"])
+        ET.SubElement(inc, "arg", name="tf_prefix", value=robot["name"])
+    path = os.path.join(RESULTS, f"scale_{count}.launch")
+    ET.ElementTree(root).write(path)
+    return path
+
+
+def scale_trial(count, real_time, seconds):
+    with Launch([scale_launch(count, real_time)], f"scale_{count}_{'rt' if real_time else 'fast'}") as launch:
+        names = [f"/robot{i + 1}" for i in range(count)]
+        for name in names:
+            subscriber(launch, [f"{name}/odom", f"{name}/joint_states"])
+        subscriber(launch, ["/tf"])
+        return launch.probe("rtf", seconds=seconds, warmup=5.0, namespaces=names, timeout=seconds + 180)
+
+
+def bench_scale(seconds):
+    """Fast-mode RTF for growing robot counts up to the first below 1, then a real-time run at the best."""
+    trials, best, count = {}, 0, 5
+    while count <= 60:
+        rtf = scale_trial(count, False, seconds)["rtf"]
+        trials[count] = rtf
+        print(f"[bench] scale: {count} robots, fast-mode RTF {rtf:.2f}", flush=True)
+        if rtf < 1.0:
+            break
+        best = count
+        count += 5 if rtf < 2.0 else 10
+    confirm = scale_trial(best, True, seconds) if best else None
+    return {"fast_rtf_by_count": trials, "max_robots_rtf_ge_1": best,
+            "realtime_rtf_at_max": confirm["rtf"] if confirm else None,
+            "sim_cpu_percent_at_max": confirm["cpu_percent"] if confirm else None}
+
+
+# -------------------------------------------------------------------------------------------------- main
+
+def table(r):
+    rows = []
+    f, b = r.get("fast"), r.get("bare")
+    if f and b:
+        rows += [("fast-mode RTF (4 topics, 4 subscriber processes)", f"{f['rtf']:.1f}", ">= 40"),
+                 ("bare PyBullet RTF, same model and step", f"{b['rtf']:.1f}", ""),
+                 ("fast / bare", f"{f['rtf'] / b['rtf']:.2f}", ">= 0.5")]
+    if r.get("realtime"):
+        rt = r["realtime"]
+        rows += [("real-time RTF error over 60 s", f"{rt['rtf_error_percent']:.3f} %", "<= 0.5 %"),
+                 ("simulator CPU in real time", f"{rt['cpu_percent']:.1f} % of a core", "<= 8 %"),
+                 ("/odom period p50 / p99", f"{rt['odom_period_p50_ms']:.2f} / {rt['odom_period_p99_ms']:.2f} ms", ""),
+                 ("/odom period jitter p99", f"{rt['odom_jitter_p99_ms']:.2f} ms", "")]
+    if r.get("latency"):
+        lat = r["latency"]
+        rows.append(("cmd_vel -> motor target p50 / p99", f"{lat['p50_ms']:.2f} / {lat['p99_ms']:.2f} ms",
+                     f"p99 <= {1000 * STEP + 2:.2f} ms"))
+    if r.get("startup"):
+        rows.append(("roslaunch -> first /odom (median of 5)", f"{r['startup']['median_s']:.2f} s", "<= 3 s"))
+    if r.get("scale"):
+        s = r["scale"]
+        rows.append(("robots at RTF >= 1 (all topics)", f"{s['max_robots_rtf_ge_1']} "
+                     f"(real-time RTF {s['realtime_rtf_at_max']:.3f})" if s["realtime_rtf_at_max"] else "0",
+                     ">= 10"))
+    width = max(len(name) for name, _, _ in rows)
+    lines = [f"{'measure'.ljust(width)}  {'value':>28}  target", "-" * (width + 40)]
+    lines += [f"{name.ljust(width)}  {value:>28}  {target}" for name, value, target in rows]
+    return "\n".join(lines)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--probe", choices=sorted(PROBES), help=argparse.SUPPRESS)
+    parser.add_argument("--options", default="{}", help=argparse.SUPPRESS)
+    parser.add_argument("--only", default="fast,realtime,latency,startup,scale",
+                        help="comma-separated items to run (default: all)")
+    parser.add_argument("--quick", action="store_true", help="shorter windows (smoke run, not for figures)")
+    args = parser.parse_args()
+    if args.probe:
+        PROBES[args.probe](json.loads(args.options))
+        return 0
+    os.makedirs(RESULTS, exist_ok=True)
+    items = set(args.only.split(","))
+    q = args.quick
+    results = {"time_step": STEP, "date": time.strftime("%Y-%m-%d %H:%M:%S"), "cpus": os.cpu_count()}
+    steps = [("fast", lambda: bench_fast(4 if q else 15)), ("bare", lambda: bench_bare(3 if q else 10)),
+             ("realtime", lambda: bench_realtime(10 if q else 60)), ("latency", lambda: bench_latency(100 if q else 600)),
+             ("startup", lambda: bench_startup(2 if q else 5)), ("scale", lambda: bench_scale(4 if q else 10))]
+    for name, run in steps:
+        wanted = name in items or (name == "bare" and "fast" in items)
+        if not wanted:
+            continue
+        print(f"[bench] {name} ...", flush=True)
+        results[name] = run()
+        print(f"[bench] {name}: {json.dumps(results[name])}", flush=True)
+    path = os.path.join(RESULTS, "bench.json")
+    with open(path, "w") as f:
+        json.dump(results, f, indent=2)
+    print(table(results))
+    print(f"[bench] written {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
