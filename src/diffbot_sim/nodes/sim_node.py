@@ -437,8 +437,14 @@ class Simulator:
                     # sets the wake rate, so CPU stays low while commands still apply within a step.
                     due = min([self.next_clock] + [r.next_due() for r in self.robots])
                     wait = (max(due, self.sim_time + dt) - target) / cfg.real_time_factor
-                    self.wake.wait(min(max(wait, 0.0), 0.1))
-                    self.wake.clear()
+                    if self.wake.wait(min(max(wait, 0.0), 0.1)):
+                        self.wake.clear()
+                        # A command woke us: set the motor targets now rather than at the next step
+                        # (up to one step later). Same sim time, so the physics sees no difference.
+                        self._handle_requests()
+                        if not self.paused:
+                            for runtime in self.robots:
+                                runtime.before_step(self.sim_time)
                     continue
             self._step_once()
 
