@@ -28,7 +28,7 @@ class SimConfig:
     time_step: float = 1.0 / 240.0  # s; measured: the fidelity targets hold at it (README)
     real_time: bool = True  # pace sim time to the wall clock; false: as fast as possible
     real_time_factor: float = 1.0  # sim seconds per wall second when real_time
-    fast_batch: float = 0.002  # s (wall); fast mode sends messages in bursts this often; 0: one write each
+    fast_batch: float = 0.005  # s (wall); fast mode sends messages in bursts this often; 0: one write each
     clock_rate: float = 100.0  # Hz of /clock, in sim time
     cmd_vel_timeout: float = 0.0  # s; 0 holds the last command (Gazebo); > 0 brakes on stale commands
     max_wheel_velocity: float = 0.0  # rad/s; 0: the URDF <limit velocity>, else FALLBACK_MAX_WHEEL_VELOCITY
