@@ -29,6 +29,7 @@ class SimConfig:
     real_time: bool = True  # pace sim time to the wall clock; false: as fast as possible
     real_time_factor: float = 1.0  # sim seconds per wall second when real_time
     fast_batch: float = 0.005  # s (wall); fast mode sends messages in bursts this often; 0: one write each
+    send_timeout: float = 0.5  # s (wall); a subscriber that takes no data for this long is disconnected
     clock_rate: float = 100.0  # Hz of /clock, in sim time
     cmd_vel_timeout: float = 0.0  # s; 0 holds the last command (Gazebo); > 0 brakes on stale commands
     max_wheel_velocity: float = 0.0  # rad/s; 0: the URDF <limit velocity>, else FALLBACK_MAX_WHEEL_VELOCITY
@@ -119,6 +120,7 @@ def sim_config(params):
     cfg.real_time_factor = _number(name("real_time_factor"), cfg.real_time_factor, low=1e-3)
     cfg.clock_rate = _number(name("clock_rate"), cfg.clock_rate, low=1e-3)
     cfg.fast_batch = _number(name("fast_batch"), cfg.fast_batch, low=0.0, high=0.1)
+    cfg.send_timeout = _number(name("send_timeout"), cfg.send_timeout, low=0.01)
     cfg.cmd_vel_timeout = _number(name("cmd_vel_timeout"), cfg.cmd_vel_timeout, low=0.0)
     cfg.max_wheel_velocity = _number(name("max_wheel_velocity"), cfg.max_wheel_velocity, low=0.0)
     for key in ("gravity", "x", "y", "z", "yaw"):

@@ -49,31 +49,37 @@ _CONTROLLER_SUFFIX = {"VelocityJointInterface": "velocity", "EffortJointInterfac
                       "PositionJointInterface": "position"}
 
 
-def _publisher(name, msg_class, synchronous, latch=False):
-    """A publisher; ``synchronous`` writes on the caller's thread (~8 us instead of ~110 us per message).
-
-    Synchronous is safe in the sim loop only where back-pressure from a slow subscriber may slow the
-    simulation (fast mode) rather than make it miss real-time deadlines.
-    """
+def _publisher(name, msg_class):
+    """A synchronous publisher: publish() writes on the loop's thread. Measured here, rospy's queued
+    publishers cost more CPU (a thread hand-off per message and connection) than the write itself; a
+    stalled subscriber is handled by SubscriberLinks' send timeout instead of by a queue."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SyntaxWarning)  # rospy warns on queue_size=None, which we mean
-        return rospy.Publisher(name, msg_class, queue_size=None if synchronous else 10, latch=latch)
+        return rospy.Publisher(name, msg_class, queue_size=None)
 
 
-class WriteBatcher:
-    """Fast mode: send our publishers' messages to each subscriber in bursts, not one TCP write each.
+class SubscriberLinks:
+    """Our publishers' TCP connections to subscribers: tuned once each, and batched in fast mode.
 
-    Measured here, a message to a subscriber process that is asleep costs the simulator ~100-150 us of
-    wall time (the loopback write wakes the receiver: a cross-CPU wake-up, dear in a VM), far more than
-    building and serializing it. Corking each connection's socket (TCP_CORK) while the loop publishes and
-    uncorking every ``interval`` wall seconds turns N writes into one wake-up per subscriber; messages and
-    their order are unchanged, each arrives at most ``interval`` late. Real-time mode does not batch.
+    Publishers are synchronous (the loop's thread writes; no queue thread per connection, which costs
+    more CPU than the write itself), so a subscriber that stops reading must not stall the loop: each
+    connection gets a send timeout, after which rospy closes and drops it (the loop goes on, the
+    subscriber sees the connection end). TCP_NODELAY stops Nagle holding a small message for an ACK.
+
+    In fast mode, a message to a subscriber that is asleep costs ~100-150 us of wall time (the loopback
+    write wakes the receiver, a cross-CPU wake-up that is dear in a VM), far more than building it; so the
+    connections are corked (TCP_CORK) while the loop publishes and uncorked every ``batch`` wall seconds:
+    N writes become one wake-up per subscriber; messages and their order are unchanged, each arrives at
+    most ``batch`` late. Real-time mode does not batch.
     """
 
-    def __init__(self, publishers, interval):
+    def __init__(self, publishers, send_timeout, batch):
         self.publishers = publishers  # callable returning the current publishers
-        self.interval = interval
+        self.send_timeout = send_timeout
+        self.batch = batch
         self.held_since = None
+        self._tuned = set()
+        self._next_scan = 0.0
 
     def _sockets(self):
         for pub in self.publishers():
@@ -82,25 +88,41 @@ class WriteBatcher:
                 if sock is not None and sock.family in (socket.AF_INET, socket.AF_INET6):
                     yield sock
 
+    def tune_new(self, now_wall):
+        """Give new connections their send timeout and TCP_NODELAY (a scan at most every 0.1 s)."""
+        if now_wall < self._next_scan:
+            return
+        self._next_scan = now_wall + 0.1
+        live = set()
+        for sock in self._sockets():
+            live.add(id(sock))
+            if id(sock) not in self._tuned:
+                try:
+                    sock.settimeout(self.send_timeout)
+                    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+                except OSError:
+                    pass  # closing under us: rospy drops it on its next write
+        self._tuned = live
+
     def _cork(self, value):
         for sock in self._sockets():
             try:
                 sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_CORK, value)
             except OSError:
-                pass  # a connection closing under us: rospy drops it on its next write
+                pass
 
     def hold(self, now_wall):
-        """Before publishing: start a batch unless one is open."""
-        if self.held_since is None:
+        """Fast mode, before publishing: start a batch unless one is open."""
+        if self.batch > 0 and self.held_since is None:
             self._cork(1)
             self.held_since = now_wall
 
     def release_if_due(self, now_wall):
-        if self.held_since is not None and now_wall - self.held_since >= self.interval:
+        if self.held_since is not None and now_wall - self.held_since >= self.batch:
             self.release()
 
     def release(self):
-        """Send everything held now (also before the loop sleeps or pauses)."""
+        """Send everything held now (also before the loop pauses, and at close)."""
         if self.held_since is not None:
             self._cork(0)
             self.held_since = None
@@ -126,7 +148,6 @@ class RobotRuntime:
         self.drive = drive
         self.joint_cfg = joint_cfg
         self.cfg = cfg
-        sync = not cfg.real_time
         self.motor_joints = {}  # joint -> transmission (non-drive motors)
         drive_joints = set(drive.left_joints + drive.right_joints) if drive else set()
         for trans in model.transmissions:
@@ -140,13 +161,13 @@ class RobotRuntime:
         self.next_js = 0.0
         self.max_wheel_velocity = None
         if drive is not None:
-            self._setup_drive(sync)
+            self._setup_drive()
         else:
             self.controller = None
         if joint_cfg is not None:
             self.js_indices = robot.indices(joint_cfg.joints)
             self.js_names = list(joint_cfg.joints)
-            self.js_pub = _publisher(_join(joint_cfg.namespace, joint_cfg.topic), JointState, sync)
+            self.js_pub = _publisher(_join(joint_cfg.namespace, joint_cfg.topic), JointState)
             self.js_builder = ros_msgs.JointStateBuilder(self.js_names)
             self.js_period = 1.0 / joint_cfg.update_rate if joint_cfg.update_rate > 0 else 0.0
         for joint, trans in self.motor_joints.items():
@@ -158,7 +179,7 @@ class RobotRuntime:
                                                       callback_args=joint, queue_size=1))
 
     # -- drive --------------------------------------------------------------------------------------
-    def _setup_drive(self, sync):
+    def _setup_drive(self):
         drive, cfg, robot = self.drive, self.cfg, self.robot
         radius = drive.wheel_radius
         self.max_wheel_velocity = cfgmod.max_wheel_velocity(cfg, robot.model, drive)
@@ -176,17 +197,17 @@ class RobotRuntime:
         self.cmd_sub = rospy.Subscriber(_join(ns, drive.command_topic), Twist, self._on_twist, queue_size=1)
         self.odom_pub = None
         if drive.publish_odom:
-            self.odom_pub = _publisher(_join(ns, drive.odometry_topic), Odometry, sync)
+            self.odom_pub = _publisher(_join(ns, drive.odometry_topic), Odometry)
         self.odom_builder = ros_msgs.OdometryBuilder(drive.odometry_frame, drive.robot_base_frame,
                                                      drive.covariance_x, drive.covariance_y, drive.covariance_yaw)
         self.tf_builder = ros_msgs.TransformBuilder(drive.odometry_frame, drive.robot_base_frame)
         self.truth_pub = None
         if cfg.publish_ground_truth:
-            self.truth_pub = _publisher(self.private + "ground_truth", Odometry, sync)
+            self.truth_pub = _publisher(self.private + "ground_truth", Odometry)
             self.truth_builder = ros_msgs.OdometryBuilder("world", drive.robot_base_frame, 0.0, 0.0, 0.0)
         self.debug_pub = None
         if cfg.debug_cmd_applied:
-            self.debug_pub = _publisher(self.private + "debug/cmd_applied", TwistStamped, False)
+            self.debug_pub = _publisher(self.private + "debug/cmd_applied", TwistStamped)
 
     def _on_twist(self, msg):
         """Subscriber thread: keep the newest *valid* command; the loop applies it at its next step.
@@ -344,19 +365,19 @@ class Simulator:
         self._requests_lock = threading.Lock()
         self.steps = 0
         self.world = World(cfg.time_step, cfg.gravity, gui=cfg.gui)
-        sync = not cfg.real_time
-        self.clock_pub = _publisher("/clock", Clock, sync)
-        self.tf_pub = _publisher("/tf", TFMessage, sync)
+        self.clock_pub = _publisher("/clock", Clock)
+        self.tf_pub = _publisher("/tf", TFMessage)
         self.robots = []
         self.clock_period = 1.0 / cfg.clock_rate
         self.next_clock = 0.0
         self._next_publish = 0.0  # sim time of the earliest publication due, over clock and every robot
         self._tf_msg = ros_msgs.tf_message([])
         self._clock_msg = ros_msgs.clock(rospy.Time(0))
-        self.batcher = WriteBatcher(self.publishers, cfg.fast_batch) if sync and cfg.fast_batch > 0 else None
+        self.owns_clock = False  # main() sets it when use_sim_time made rospy follow /clock
+        self.links = SubscriberLinks(self.publishers, cfg.send_timeout, 0.0 if cfg.real_time else cfg.fast_batch)
 
     def publishers(self):
-        """Every publisher the loop writes to (the write batcher corks their connections)."""
+        """Every publisher the loop writes to (SubscriberLinks tunes and batches their connections)."""
         pubs = [self.clock_pub, self.tf_pub]
         for runtime in self.robots:
             pubs += [p for p in (getattr(runtime, "odom_pub", None), getattr(runtime, "truth_pub", None),
@@ -425,8 +446,7 @@ class Simulator:
         while not rospy.is_shutdown():
             self._handle_requests()
             if self.paused:
-                if self.batcher is not None:
-                    self.batcher.release()
+                self.links.release()
                 self.wake.wait(0.1)
                 self.wake.clear()
                 continue
@@ -456,13 +476,13 @@ class Simulator:
         self.steps += 1
         now = self.sim_time
         if now + 1e-9 < self._next_publish:
-            if self.batcher is not None and self.batcher.held_since is not None:
-                self.batcher.release_if_due(time.monotonic())
+            if self.links.held_since is not None:
+                self.links.release_if_due(time.monotonic())
             return  # most steps publish nothing: skip building a stamp and asking every robot
         stamp = self._stamp()
-        if self.batcher is not None:
-            wall = time.monotonic()
-            self.batcher.hold(wall)
+        wall = time.monotonic()
+        self.links.tune_new(wall)
+        self.links.hold(wall)
         transforms = []
         for runtime in self.robots:
             runtime.after_step(now, stamp, transforms)
@@ -472,8 +492,7 @@ class Simulator:
         if now + 1e-9 >= self.next_clock:
             self._publish_clock(now)
         self._next_publish = min([self.next_clock] + [r.next_publish() for r in self.robots])
-        if self.batcher is not None:
-            self.batcher.release_if_due(wall)
+        self.links.release_if_due(wall)
 
     def _stamp(self):
         """Sim time as a rospy.Time, via integer nanoseconds (cheaper than Time.from_sec's float path)."""
@@ -481,14 +500,16 @@ class Simulator:
         return rospy.Time(secs, nsecs)
 
     def _publish_clock(self, now):
+        stamp = self._stamp()
+        if self.owns_clock:
+            rospy.rostime._set_rostime(stamp)  # this node's own sim time (see _own_the_clock)
         if self.clock_pub.get_num_connections():
-            self._clock_msg.clock = self._stamp()
+            self._clock_msg.clock = stamp
             self.clock_pub.publish(self._clock_msg)
         self.next_clock = _next_due(self.next_clock, self.clock_period, now)
 
     def close(self):
-        if self.batcher is not None:
-            self.batcher.release()
+        self.links.release()
         self.world.close()
 
 
@@ -580,9 +601,23 @@ def _report(cfg, loaded):
         rospy.loginfo(f"bullet_sim: {who}model {model.source} ({model.name}); {summary}")
 
 
+def _own_the_clock():
+    """Stop rospy listening to /clock in this node: with use_sim_time, init_node subscribes every node to
+    /clock, so the simulator would receive (a loopback wake-up and a deserialization) each tick it
+    publishes. rospy's time is set directly in _publish_clock instead, through the hook rospy's own /clock
+    callback uses (rospy.rostime._set_rostime)."""
+    from rospy.impl import simtime
+    sub = getattr(simtime, "_clock_sub", None)
+    if sub is not None:
+        sub.unregister()
+        simtime._clock_sub = None
+    return sub is not None
+
+
 def main(argv=None):
     """Entry point of ``rosrun diffbot_sim bullet_sim``. Exits 1 with one line on bad input."""
     rospy.init_node("bullet_sim")
+    owns_clock = _own_the_clock()
     try:
         params = rospy.get_param("~", {})
         cfg = cfgmod.sim_config(params)
@@ -590,6 +625,7 @@ def main(argv=None):
             rospy.logwarn("~gui is true but there is no display (DISPLAY unset): running headless (DIRECT)")
             cfg.gui = False
         sim, loaded = build(cfg, params)
+        sim.owns_clock = owns_clock
     except DiffbotSimError as err:
         rospy.logfatal(f"bullet_sim: {err}")
         rospy.signal_shutdown("bad input")
