@@ -196,7 +196,10 @@ class FloodTest(unittest.TestCase):
                f"(about {steps:.0f} physics steps)")
         for ident, count in per_flooder.items():
             self.assertGreater(count, 0, f"no command of flooder {ident} was ever applied")
-        self.assertLessEqual(sum(per_flooder.values()), steps * 1.1, "at most one command applied per step")
+        # In real time a command that wakes the loop is applied at once, between steps; only the newest
+        # pending one is taken each time, so the simulator applies a fraction of what arrives.
+        sent = sum(r["sent"] for r in self.results)
+        self.assertLess(sum(per_flooder.values()), sent / 2, "the simulator applied most arriving commands one by one")
 
     def test_5_newest_command_wins_within_one_step(self):
         rec = self.rec
