@@ -176,8 +176,8 @@ def probe_rtf(options):
     rospy.Subscriber("/clock", Clock, lambda m: clock.append((time.monotonic(), m.clock.to_sec())),
                      queue_size=1000)
     if options.get("odom_jitter"):
-        rospy.Subscriber(options.get("odom", "/odom"), Odometry, lambda m: odom.append(time.monotonic()),
-                         queue_size=1000)
+        rospy.Subscriber(options.get("odom", "/odom"), Odometry,
+                         lambda m: odom.append((time.monotonic(), m.header.stamp.to_sec())), queue_size=1000)
     _wait(lambda: len(clock) > 2, 60, "/clock")
     pubs = [rospy.Publisher(f"{ns}/cmd_vel", Twist, queue_size=1, latch=True)
             for ns in options.get("namespaces", [""])]
@@ -194,12 +194,15 @@ def probe_rtf(options):
     result = {"rtf": (s1 - s0) / (w1 - w0), "cpu_percent": 100.0 * (cpu1 - cpu0) / (w1 - w0),
               "wall_s": w1 - w0, "sim_s": s1 - s0}
     if options.get("odom_jitter"):
-        stamps = [t for t in odom if w0 <= t <= w1]
-        periods = [1000.0 * (b - a) for a, b in zip(stamps, stamps[1:])]
-        nominal = 1000.0 / options["odom_rate"]
+        window = [(t, s) for t, s in odom if w0 <= t <= w1]
+        periods = [1000.0 * (b[0] - a[0]) for a, b in zip(window, window[1:])]
+        # Delivery jitter: how far each message's arrival strays from where its sim stamp puts it. The
+        # stamps themselves alternate 8.33/12.5 ms (a 100 Hz rate on a 240 Hz step), which is not jitter.
+        offsets = [t - s for t, s in window]
+        middle = statistics.median(offsets)
         result.update({"odom_period_p50_ms": percentile(periods, 50), "odom_period_p99_ms": percentile(periods, 99),
-                       "odom_jitter_p99_ms": percentile([abs(p - nominal) for p in periods], 99),
-                       "odom_messages": len(stamps)})
+                       "odom_jitter_p99_ms": percentile([1000.0 * abs(o - middle) for o in offsets], 99),
+                       "odom_messages": len(window)})
     print(json.dumps(result), flush=True)
 
 
@@ -302,14 +305,20 @@ def bench_fast(seconds, repeats):
     return out
 
 
-def bench_realtime(seconds):
+def realtime_trial(seconds, extra_subscribers):
     with Launch(sim_args(), "realtime") as launch:
-        for topic in ("/joint_states", "/tf"):
+        for topic in extra_subscribers:
             subscriber(launch, [topic])
-        result = launch.probe("rtf", seconds=seconds, warmup=3.0, odom_jitter=True, odom_rate=100.0,
-                              timeout=seconds + 120)
+        result = launch.probe("rtf", seconds=seconds, warmup=3.0, odom_jitter=True, timeout=seconds + 120)
     result["rtf_error_percent"] = 100.0 * abs(result["rtf"] - 1.0)
     return result
+
+
+def bench_realtime(seconds):
+    """sim.launch defaults (with robot_state_publisher; rosout and it follow /clock); the probe subscribes
+    /clock and /odom. Then the same with /joint_states and /tf also subscribed by processes of their own."""
+    return {"realtime": realtime_trial(seconds, ()),
+            "realtime_all_topics": realtime_trial(seconds, ("/joint_states", "/tf"))}
 
 
 def bench_latency(count):
@@ -414,12 +423,15 @@ def table(r):
                  ("  fast / bare", f"{f['rtf'] / b['rtf']:.2f}", ">= 0.5"),
                  ("fast-mode RTF, robot_state_publisher:=false", f"{n['rtf']:.1f}", ">= 40"),
                  ("  fast / bare", f"{n['rtf'] / b['rtf']:.2f}", ">= 0.5")]
-    if r.get("realtime"):
-        rt = r["realtime"]
-        rows += [("real-time RTF error over 60 s", f"{rt['rtf_error_percent']:.3f} %", "<= 0.5 %"),
-                 ("simulator CPU in real time", f"{rt['cpu_percent']:.1f} % of a core", "<= 8 %"),
-                 ("/odom period p50 / p99", f"{rt['odom_period_p50_ms']:.2f} / {rt['odom_period_p99_ms']:.2f} ms", ""),
-                 ("/odom period jitter p99", f"{rt['odom_jitter_p99_ms']:.2f} ms", "")]
+    for key, label in (("realtime", "real time, /clock + /odom subscribed"),
+                       ("realtime_all_topics", "real time, all four topics subscribed")):
+        if r.get(key):
+            rt = r[key]
+            rows += [(f"{label}: RTF error over {rt['wall_s']:.0f} s", f"{rt['rtf_error_percent']:.3f} %", "<= 0.5 %"),
+                     ("  simulator CPU", f"{rt['cpu_percent']:.1f} % of a core", "<= 8 %"),
+                     ("  /odom arrival period p50 / p99", f"{rt['odom_period_p50_ms']:.2f} / "
+                      f"{rt['odom_period_p99_ms']:.2f} ms", ""),
+                     ("  /odom delivery jitter p99", f"{rt['odom_jitter_p99_ms']:.2f} ms", "")]
     if r.get("latency"):
         lat = r["latency"]
         rows.append(("cmd_vel -> motor target p50 / p99", f"{lat['p50_ms']:.2f} / {lat['p99_ms']:.2f} ms",
@@ -463,7 +475,7 @@ def main():
         if not wanted:
             continue
         print(f"[bench] {name} ...", flush=True)
-        if name == "fast":
+        if name in ("fast", "realtime"):
             results.update(run())
         else:
             results[name] = run()

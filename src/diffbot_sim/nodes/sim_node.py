@@ -456,7 +456,10 @@ class Simulator:
                     # Sleep until the next thing due (or a command wakes us). Publishing, not stepping,
                     # sets the wake rate, so CPU stays low while commands still apply within a step.
                     due = min([self.next_clock] + [r.next_due() for r in self.robots])
-                    wait = (max(due, self.sim_time + dt) - target) / cfg.real_time_factor
+                    # Wake at the step that reaches ``due`` (steps land on multiples of dt), not at ``due``
+                    # itself: waking between steps would only find nothing to do and sleep again.
+                    step_at = math.ceil(due / dt - 1e-6) * dt
+                    wait = (max(step_at, self.sim_time + dt) - target) / cfg.real_time_factor
                     if self.wake.wait(min(max(wait, 0.0), 0.1)):
                         self.wake.clear()
                         # A command woke us: set the motor targets now rather than at the next step
