@@ -281,6 +281,34 @@ def bench_bare(seconds):
     return {"steps_per_s": steps / elapsed, "rtf": steps * STEP / elapsed}
 
 
+def bench_bare_paced(seconds):
+    """The same model stepped by PyBullet alone but paced to the wall clock, waking every 10 ms (the
+    simulator's publish period) to run the steps due: the floor under the simulator's real-time CPU."""
+    import threading
+    import pybullet
+    sys.path.insert(0, os.path.join(ROOT, "src"))
+    from diffbot_sim.description import load_file
+    from diffbot_sim.model import parse_urdf
+    from diffbot_sim.physics import World
+    text = load_file(MODEL)
+    world = World(STEP)
+    try:
+        robot = world.load_robot(text, parse_urdf(text, MODEL))
+        robot.set_velocities(robot.indices(["left_wheel_joint", "right_wheel_joint"]), [5.0, 8.0], [30.0, 30.0])
+        sleeper, steps = threading.Event(), 0
+        cpu0, start = time.process_time(), time.monotonic()
+        while time.monotonic() - start < seconds:
+            while (steps + 1) * STEP <= time.monotonic() - start:
+                pybullet.stepSimulation(physicsClientId=world.client)
+                steps += 1
+            wake = (int((steps + 1) * STEP / 0.01 - 1e-9) + 1) * 0.01
+            sleeper.wait(max(0.0, wake - (time.monotonic() - start)))
+        elapsed = time.monotonic() - start
+        return {"cpu_percent": 100.0 * (time.process_time() - cpu0) / elapsed, "rtf": steps * STEP / elapsed}
+    finally:
+        world.close()
+
+
 def fast_trial(seconds, rsp):
     with Launch(sim_args("real_time:=false", f"robot_state_publisher:={str(rsp).lower()}"), "fast") as launch:
         for topic in TOPICS[1:]:  # /clock is subscribed by the RTF probe itself, a process of its own
@@ -318,7 +346,8 @@ def bench_realtime(seconds):
     """sim.launch defaults (with robot_state_publisher; rosout and it follow /clock); the probe subscribes
     /clock and /odom. Then the same with /joint_states and /tf also subscribed by processes of their own."""
     return {"realtime": realtime_trial(seconds, ()),
-            "realtime_all_topics": realtime_trial(seconds, ("/joint_states", "/tf"))}
+            "realtime_all_topics": realtime_trial(seconds, ("/joint_states", "/tf")),
+            "bare_paced": bench_bare_paced(min(seconds, 20.0))}
 
 
 def bench_latency(count):
@@ -432,6 +461,8 @@ def table(r):
                      ("  /odom arrival period p50 / p99", f"{rt['odom_period_p50_ms']:.2f} / "
                       f"{rt['odom_period_p99_ms']:.2f} ms", ""),
                      ("  /odom delivery jitter p99", f"{rt['odom_jitter_p99_ms']:.2f} ms", "")]
+    if r.get("bare_paced"):
+        rows.append(("bare PyBullet paced to real time, CPU (the floor)", f"{r['bare_paced']['cpu_percent']:.1f} % of a core", ""))
     if r.get("latency"):
         lat = r["latency"]
         rows.append(("cmd_vel -> motor target p50 / p99", f"{lat['p50_ms']:.2f} / {lat['p99_ms']:.2f} ms",
