@@ -11,7 +11,9 @@ import subprocess
 import sys
 import time
 import unittest
+import xmlrpc.client
 
+import rosgraph
 import rospy
 import rostest
 from rosgraph_msgs.msg import Clock
@@ -19,6 +21,7 @@ from rosgraph_msgs.msg import Clock
 from simtest import figure
 
 SUBSCRIBER = """
+import rosgraph
 import rospy
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
@@ -32,29 +35,49 @@ rospy.spin()
 
 
 class StalledSubscriberTest(unittest.TestCase):
+    def _frozen_links(self):
+        """The simulator's open connections to the frozen node, from its getBusInfo."""
+        _, _, info = self.sim.getBusInfo("/test_stalled")
+        return [c for c in info if c[1].startswith("/frozen") and c[5]]
+
+    def _wait(self, predicate, timeout, what):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            value = predicate()
+            if value:
+                return value
+            time.sleep(0.05)
+        _, _, info = self.sim.getBusInfo("/test_stalled")
+        self.fail(f"timed out after {timeout} s waiting for {what}; simulator connections: "
+                  + "; ".join(f"{c[1]} {c[4]} {'up' if c[5] else 'down'}" for c in info))
+
     def test_frozen_subscriber_is_dropped_and_the_sim_goes_on(self):
         rospy.init_node("test_stalled")
         clock = []
-        rospy.Subscriber("/clock", Clock, lambda m: clock.append((time.monotonic(), m.clock.to_sec())),
-                         queue_size=100)
+        rospy.Subscriber("/clock", Clock, lambda m: clock.append(m.clock.to_sec()), queue_size=100)
+        deadline = time.monotonic() + 30.0
+        while not clock and time.monotonic() < deadline:
+            time.sleep(0.05)
+        self.assertTrue(clock, "no /clock from the simulator")
+        self.sim = xmlrpc.client.ServerProxy(rosgraph.Master("/test_stalled").lookupNode("/bullet_sim"))
         proc = subprocess.Popen([sys.executable, "-c", SUBSCRIBER], stdout=subprocess.PIPE, text=True)
         try:
             self.assertEqual(proc.stdout.readline().strip(), "subscribed")
-            deadline = time.monotonic() + 20
-            while time.monotonic() < deadline and not clock:
-                time.sleep(0.05)
-            self.assertTrue(clock, "no /clock from the simulator")
-            time.sleep(2.0)  # the frozen process is connected and receiving by now
+            self._wait(lambda: {"/odom", "/joint_states", "/tf"} <= {c[4] for c in self._frozen_links()}, 20.0,
+                       "the frozen-to-be node connected on /odom, /joint_states and /tf")
             os.kill(proc.pid, signal.SIGSTOP)
             frozen_at = time.monotonic()
-            # Long enough to fill its socket buffers many times over at fast-mode rates.
-            time.sleep(12.0)
-            recent = [(w, s) for w, s in clock if w > time.monotonic() - 3.0]
-            self.assertGreater(len(recent), 10, "the simulator stopped publishing /clock")
-            advanced = recent[-1][1] - recent[0][1]
-            figure(f"stalled: sim time advanced {advanced:.1f} s in the last 3 s wall, "
-                   f"{time.monotonic() - frozen_at:.0f} s after SIGSTOP")
-            self.assertGreater(advanced, 3.0, "sim time stalled behind a frozen subscriber")
+            # Its socket buffers fill within seconds at fast-mode rates; then a write times out
+            # (~send_timeout) and rospy closes that connection. Without the guard it never happens.
+            # (/clock, 8 bytes a message, would take minutes to fill a buffer: only the big topics count.)
+            big = {"/odom", "/joint_states", "/tf"}
+            self._wait(lambda: not big & {c[4] for c in self._frozen_links()}, 60.0,
+                       "the simulator to drop the frozen subscriber's odom, joint_states and tf connections")
+            dropped = time.monotonic() - frozen_at
+            start = clock[-1]
+            self._wait(lambda: clock[-1] >= start + 5.0, 10.0, "sim time to advance 5 s after the drop")
+            figure(f"stalled: frozen subscriber dropped {dropped:.1f} s after SIGSTOP; sim time then advanced "
+                   f"{clock[-1] - start:.1f} s")
         finally:
             os.kill(proc.pid, signal.SIGCONT)
             proc.kill()

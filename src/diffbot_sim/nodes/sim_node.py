@@ -93,10 +93,10 @@ class SubscriberLinks:
         if now_wall < self._next_scan:
             return
         self._next_scan = now_wall + 0.1
-        live = set()
+        live = set()  # the socket objects themselves: an id() could be reused by a later socket
         for sock in self._sockets():
-            live.add(id(sock))
-            if id(sock) not in self._tuned:
+            live.add(sock)
+            if sock not in self._tuned:
                 try:
                     sock.settimeout(self.send_timeout)
                     sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
@@ -381,7 +381,8 @@ class Simulator:
         pubs = [self.clock_pub, self.tf_pub]
         for runtime in self.robots:
             pubs += [p for p in (getattr(runtime, "odom_pub", None), getattr(runtime, "truth_pub", None),
-                                 getattr(runtime, "js_pub", None)) if p is not None]
+                                 getattr(runtime, "js_pub", None), getattr(runtime, "debug_pub", None))
+                     if p is not None]
         return pubs
 
     def warn(self, key, text):
