@@ -380,14 +380,13 @@ def bench_startup(runs):
     return {"median_s": statistics.median(times), "runs_s": times}
 
 
-def scale_launch(count, real_time, rsp):
-    """A launch file for ``count`` namespaced seed robots on a 1 m grid (like multi.launch), each with its
-    robot_state_publisher when ``rsp``."""
+def scale_launch(count, rsp):
+    """A real-time launch file for ``count`` namespaced seed robots on a 1 m grid (like multi.launch), each
+    with its robot_state_publisher when ``rsp``."""
     root = ET.Element("launch")
     ET.SubElement(root, "param", name="use_sim_time", value="true")
     ET.SubElement(root, "param", name="robot_description", command=f"xacro '{MODEL}'")
     node = ET.SubElement(root, "node", name="bullet_sim", pkg="diffbot_sim", type="bullet_sim", required="true")
-    ET.SubElement(node, "param", name="real_time", value=str(real_time).lower())
     robots = [{"name": f"robot{i + 1}", "x": float(i % 10), "y": float(i // 10)} for i in range(count)]
     ET.SubElement(node, "rosparam", param="robots").text = json.dumps(robots)
     for robot in robots if rsp else ():
@@ -398,9 +397,9 @@ def scale_launch(count, real_time, rsp):
     return path
 
 
-def scale_trial(count, real_time, seconds, rsp):
-    tag = f"scale_{count}_{'rt' if real_time else 'fast'}{'_rsp' if rsp else ''}"
-    with Launch([scale_launch(count, real_time, rsp)], tag) as launch:
+def scale_trial(count, seconds, rsp):
+    tag = f"scale_{count}{'_rsp' if rsp else ''}"
+    with Launch([scale_launch(count, rsp)], tag) as launch:
         names = [f"/robot{i + 1}" for i in range(count)]
         for name in names:  # one consumer process per robot, as each robot would have its own nodes
             subscriber(launch, [f"{name}/odom", f"{name}/joint_states"])
@@ -417,7 +416,7 @@ def bench_scale(seconds, rsp):
 
     def ok(count):
         if count not in trials:
-            trials[count] = scale_trial(count, True, seconds, rsp)
+            trials[count] = scale_trial(count, seconds, rsp)
             print(f"[bench] scale{' +rsp' if rsp else ''}: {count} robots, real-time RTF "
                   f"{trials[count]['rtf']:.3f}, simulator CPU {trials[count]['cpu_percent']:.0f} %", flush=True)
         return trials[count]["rtf"] >= 0.99

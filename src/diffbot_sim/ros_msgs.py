@@ -122,11 +122,6 @@ class PackedTFMessage(TFMessage):
             transform.serialize(buff)
 
 
-def transform(stamp, frame, child, position, orientation):
-    """A new transform (for one-off use; the simulator loop uses TransformBuilder)."""
-    return TransformBuilder(frame, child).build(stamp, position, orientation)
-
-
 def tf_message(transforms):
     """All of a step's transforms in one TFMessage (one publish, not one per frame)."""
     return PackedTFMessage(transforms=list(transforms))
@@ -163,11 +158,6 @@ class JointStateBuilder:
         msg.header.stamp = stamp
         msg.position, msg.velocity, msg.effort = positions, velocities, efforts
         return msg
-
-
-def joint_state(stamp, names, positions, velocities, efforts):
-    """A new JointState (one-off use; the simulator loop uses JointStateBuilder)."""
-    return JointStateBuilder(names).build(stamp, positions, velocities, efforts)
 
 
 def clock(stamp):

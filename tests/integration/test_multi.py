@@ -56,6 +56,14 @@ class MultiRobotTest(unittest.TestCase):
         self.assertIn("/robot1/cmd_vel", topics)
         self.assertIn("/robot2/cmd_vel", topics)
 
+    def test_1_the_simulator_does_not_follow_its_own_clock(self):
+        """It owns sim time; under use_sim_time rospy would subscribe it to the /clock it publishes."""
+        self.assertTrue(rospy.get_param("/use_sim_time"))
+        _, subscribers, _ = rosgraph.Master("/test_multi").getSystemState()
+        clock_subscribers = dict(subscribers).get("/clock", [])
+        self.assertIn("/robot1/robot_state_publisher", clock_subscribers)  # the check can see a subscriber
+        self.assertNotIn(SIM, clock_subscribers)
+
     def test_2_each_robot_follows_its_own_commands(self):
         rec = self.rec
         a0, b0 = rec.last(rec.odom), rec.last(rec.extra)

@@ -309,7 +309,8 @@ def test_sim_config_values_and_coercion():
     ("time_step", 0), ("time_step", -0.01), ("time_step", float("nan")), ("time_step", 1.0),
     ("time_step", True), ("time_step", "fast"), ("gui", "maybe"), ("real_time", 2),
     ("cmd_vel_timeout", -1), ("clock_rate", 0), ("gravity", float("inf")), ("model", 3),
-    ("publish_ground_truth", "yes please"),
+    ("publish_ground_truth", "yes please"), ("fast_batch", -0.001), ("fast_batch", 0.5),
+    ("send_timeout", 0), ("send_timeout", "never"),
 ])
 def test_sim_config_rejects(key, value):
     with pytest.raises(ConfigError) as info:

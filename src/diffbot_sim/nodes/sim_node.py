@@ -160,6 +160,7 @@ class RobotRuntime:
         self.next_odom = 0.0
         self.next_js = 0.0
         self.max_wheel_velocity = None
+        self.odom_pub = self.truth_pub = self.debug_pub = self.js_pub = None
         if drive is not None:
             self._setup_drive()
         else:
@@ -195,22 +196,20 @@ class RobotRuntime:
         self.encoder = EncoderOdometry(radius, drive.wheel_separation)
         ns = drive.namespace
         self.cmd_sub = rospy.Subscriber(_join(ns, drive.command_topic), Twist, self._on_twist, queue_size=1)
-        self.odom_pub = None
         if drive.publish_odom:
             self.odom_pub = _publisher(_join(ns, drive.odometry_topic), Odometry)
         self.odom_builder = ros_msgs.OdometryBuilder(drive.odometry_frame, drive.robot_base_frame,
                                                      drive.covariance_x, drive.covariance_y, drive.covariance_yaw)
         self.tf_builder = ros_msgs.TransformBuilder(drive.odometry_frame, drive.robot_base_frame)
-        self.truth_pub = None
         if cfg.publish_ground_truth:
             self.truth_pub = _publisher(self.private + "ground_truth", Odometry)
             self.truth_builder = ros_msgs.OdometryBuilder("world", drive.robot_base_frame, 0.0, 0.0, 0.0)
-        self.debug_pub = None
         if cfg.debug_cmd_applied:
             self.debug_pub = _publisher(self.private + "debug/cmd_applied", TwistStamped)
 
     def _on_twist(self, msg):
-        """Subscriber thread: keep the newest *valid* command; the loop applies it at its next step.
+        """Subscriber thread: keep the newest *valid* command and wake the loop, which applies it (at once
+        in real time, at the next step in fast mode).
 
         Validating here (not in the loop) means a burst of a good command followed by a NaN one keeps the
         good one, as diff_drive_controller does.
@@ -282,6 +281,10 @@ class RobotRuntime:
             self.robot.set_positions(idx, [value], [force])
         else:
             self.robot.set_efforts(idx, [max(-force, min(force, value))])
+
+    def publishers(self):
+        """This robot's publishers that the loop writes to."""
+        return [p for p in (self.odom_pub, self.truth_pub, self.debug_pub, self.js_pub) if p is not None]
 
     def next_publish(self):
         """Sim time of this robot's next odom/TF or joint_states publication."""
@@ -380,9 +383,7 @@ class Simulator:
         """Every publisher the loop writes to (SubscriberLinks tunes and batches their connections)."""
         pubs = [self.clock_pub, self.tf_pub]
         for runtime in self.robots:
-            pubs += [p for p in (getattr(runtime, "odom_pub", None), getattr(runtime, "truth_pub", None),
-                                 getattr(runtime, "js_pub", None), getattr(runtime, "debug_pub", None))
-                     if p is not None]
+            pubs += runtime.publishers()
         return pubs
 
     def warn(self, key, text):
@@ -454,8 +455,8 @@ class Simulator:
             if cfg.real_time:
                 target = self.sim0 + (time.monotonic() - self.wall0) * cfg.real_time_factor
                 if self.sim_time + dt > target + 1e-9:
-                    # Sleep until the next thing due (or a command wakes us). Publishing, not stepping,
-                    # sets the wake rate, so CPU stays low while commands still apply within a step.
+                    # Sleep until the next thing due, or until a command wakes us. Publishing and control,
+                    # not stepping, set the wake rate, so CPU stays low.
                     due = min([self.next_clock] + [r.next_due() for r in self.robots])
                     # Wake at the step that reaches ``due`` (steps land on multiples of dt), not at ``due``
                     # itself: waking between steps would only find nothing to do and sleep again.
