@@ -183,4 +183,10 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from diffbot_sim import streams  # a closed pipe (`make test | head`) must not turn the status into 120
+
+    try:
+        STATUS = main()
+    finally:
+        streams.finish()
+    sys.exit(STATUS)

@@ -1,6 +1,9 @@
 #!/usr/bin/env python3
 """Runs every test of the project and ends with one line `N passed, N failed`.
 
+Every process it starts gets a user's environment (``user_env``: no ``PYTHONUNBUFFERED`` and the other
+variables in NOT_ON_A_USERS_MACHINE), so a fault that only shows on a user's machine shows here too.
+
 pytest (unit tests, no master) runs first; then each rostest suite in tests/integration/*.test, two at a time
 (each rostest starts its own master on a free port). rostest is judged by its exit status and its result
 XML files, never by its console output, which says OK even when a test node crashed.
@@ -17,6 +20,43 @@ import time
 import xml.etree.ElementTree as ET
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+#: Variables a user's shell does not have but a development machine or CI may: every process the runner
+#: starts runs without them, so the suite passes or fails as it would on a user's machine.
+NOT_ON_A_USERS_MACHINE = {
+    # Unbuffered output hid an exit status of 120 (a failed flush of buffered output at exit) on CI.
+    "PYTHONUNBUFFERED": "makes stdout/stderr unbuffered, hiding faults of buffered output",
+    "PYTHONDONTWRITEBYTECODE": "users' Python writes __pycache__; imports must work with it",
+    "PYTHONIOENCODING": "changes how text reaches terminals and pipes",
+    "PYTHONWARNINGS": "turns warnings on or into errors",
+    "PYTHONDEVMODE": "debug hooks and extra warnings",
+    "PYTHONFAULTHANDLER": "prints tracebacks a user would not see",
+    "PYTHONHASHSEED": "fixes set/dict orders that vary on a user's machine",
+    "PYTHONMALLOC": "another allocator",
+    "PYTHONSTARTUP": "interactive start-up file",
+    "PYTHONINSPECT": "keeps the interpreter alive after a script ends",
+    "PYTHONOPTIMIZE": "strips asserts and docstrings",
+    "PYTHONBREAKPOINT": "debugger hook",
+    # pyenv's Python is this machine's, not a user's; ROS runs on Debian's /usr/bin/python3 (and our venv).
+    "PYENV_ROOT": "pyenv is not on a user's machine",
+    "PYENV_VERSION": "pyenv is not on a user's machine",
+    "PYENV_DIR": "pyenv is not on a user's machine",
+    "VIRTUAL_ENV": "a user has no venv active; the workspace's setup puts ours on PATH",
+    "CI": "set by CI only; nothing of ours may behave differently under it",
+}
+
+
+def say(text):
+    """Print a line of the runner's report; a reader that went away (``| head``) changes no status."""
+    from diffbot_sim import streams
+
+    streams.write(sys.stdout, text + "\n")
+
+
+def user_env(**extra):
+    """os.environ without NOT_ON_A_USERS_MACHINE, plus ``extra``: what every spawned process gets."""
+    env = {k: v for k, v in os.environ.items() if k not in NOT_ON_A_USERS_MACHINE}
+    env.update(extra)
+    return env
 RESULTS = os.path.join(ROOT, "test-results")
 TIMING_MARK = "diffbot_sim: timing-sensitive"
 
@@ -64,12 +104,12 @@ def run_pytest(slow):
     if not slow:
         cmd += ["-m", "not slow"]
     started = time.monotonic()
-    proc = subprocess.run(cmd, cwd=ROOT)
+    proc = subprocess.run(cmd, cwd=ROOT, env=user_env())
     passed, failed, skipped, names = count_junit([out]) if os.path.exists(out) else (0, 0, 0, [])
     if proc.returncode not in (0, 5) and failed == 0:
         failed, names = 1, [f"pytest exited {proc.returncode}"]
-    print(f"[tests] pytest: {passed} passed, {failed} failed, {skipped} skipped "
-          f"({time.monotonic() - started:.0f} s)", flush=True)
+    say(f"[tests] pytest: {passed} passed, {failed} failed, {skipped} skipped "
+          f"({time.monotonic() - started:.0f} s)")
     return passed, failed, skipped, names
 
 
@@ -80,7 +120,7 @@ def run_rostest(test_file):
     os.makedirs(base)
     log_path = os.path.join(base, "console.log")
     started = time.monotonic()
-    env = dict(os.environ, ROS_HOME=os.path.join(base, "ros_home"))
+    env = user_env(ROS_HOME=os.path.join(base, "ros_home"))
     with open(log_path, "w") as log:
         try:
             proc = subprocess.run(["rostest", "--results-base-dir", base, "diffbot_sim", os.path.basename(test_file)],
@@ -128,17 +168,23 @@ def main():
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         for phase in phases:
             for name, p, f, s, n, secs in pool.map(run_rostest, phase):
-                print(f"[tests] rostest {name}: {p} passed, {f} failed ({secs:.0f} s)", flush=True)
+                say(f"[tests] rostest {name}: {p} passed, {f} failed ({secs:.0f} s)")
                 total_p, total_f, total_s = total_p + p, total_f + f, total_s + s
                 failures += n
     for name in failures:
-        print(f"[tests] FAILED: {name}")
+        say(f"[tests] FAILED: {name}")
     line = f"{total_p} passed, {total_f} failed"
     if total_s:
         line += f", {total_s} skipped"
-    print(line, flush=True)
+    say(line)
     return 1 if total_f else 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from diffbot_sim import streams  # a closed pipe (`make test | head`) must not turn the status into 120
+
+    try:
+        STATUS = main()
+    finally:
+        streams.finish()
+    sys.exit(STATUS)

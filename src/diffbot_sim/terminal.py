@@ -12,6 +12,7 @@ import os
 import select
 import termios
 
+from . import streams
 from .errors import TerminalError
 
 #: What :func:`read_key` returns when standard input is closed (end of file, or the terminal hung up).
@@ -143,8 +144,5 @@ class StatusLine:
             self._shown = None
 
     def _write(self, data):
-        try:
-            self._stream.write(data)
-            self._stream.flush()
-        except (OSError, ValueError):
-            self._enabled = False
+        if not streams.write(self._stream, data):
+            self._enabled = False  # the terminal is gone (its descriptor now writes to /dev/null)

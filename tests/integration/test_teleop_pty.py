@@ -13,6 +13,7 @@ import re
 import select
 import signal
 import subprocess
+import tempfile
 import termios
 import threading
 import time
@@ -305,9 +306,62 @@ class TestTeleopPty(unittest.TestCase):
         self.wait_for(lambda: len(self.msgs) > before, STOP_BOUND * 5, "the stop after end of input")
         latency = self.msgs.all()[before][0] - sent
         print(f"[teleop_pty] stdin closed -> zero Twist: {latency * 1000:.1f} ms")
-        self.assertEqual(self.wait_exit(), 0)
+        self.assertEqual(self.wait_exit(), 0, "exit status 120 is a failed flush of buffered output at exit")
         self.assert_ends_with_one_zero(before)
         self.assertLess(latency, STOP_BOUND)
+
+    def _start_split(self, stdout):
+        """Start a teleop with stdin on a fresh pty, stdout on ``stdout`` and stderr in a file we read."""
+        self.master, self.slave = pty.openpty()
+        self.attrs_before = termios.tcgetattr(self.slave)
+        self.stderr_file = tempfile.TemporaryFile()
+        self.last_name = next(self.names)
+        name = f"teleop_key_{self.last_name}"
+        self.proc = subprocess.Popen(["rosrun", PKG, "teleop_key", f"__name:={name}"],
+                                     stdin=self.slave, stdout=stdout, stderr=self.stderr_file,
+                                     start_new_session=True, close_fds=True)
+        self.wait_for(lambda: self.publisher_connected(name, self.sub.resolved_name) or self.proc.poll() is not None,
+                      START_TIMEOUT, f"{name} to connect to our {self.sub.resolved_name} subscriber")
+        self.assertIsNone(self.proc.poll(), "teleop exited during start-up: " + self.stderr_text())
+
+    def stderr_text(self):
+        self.stderr_file.seek(0)
+        return self.stderr_file.read().decode("utf-8", "replace")
+
+    def assert_clean_stderr(self):
+        text = self.stderr_text()
+        for bad in ("Exception ignored", "Traceback", "BrokenPipeError"):
+            self.assertNotIn(bad, text)
+
+    def test_stdout_pipe_closed_exits_0(self):
+        """``teleop_key | head -1`` after head has gone: every write to stdout meets a closed pipe."""
+        read_end, write_end = os.pipe()
+        os.close(read_end)  # the reader is gone before the node writes its banner
+        try:
+            self._start_split(write_end)
+        finally:
+            os.close(write_end)
+        self.press_and_expect("i", 1.0, 0.0)
+        self.press_and_expect("q", 1.1, 0.0)
+        before = len(self.msgs)
+        self.type("\x03")
+        self.assertEqual(self.wait_exit(), 0, self.stderr_text())
+        self.assert_ends_with_one_zero(before)
+        self.assert_terminal_restored()
+        self.assert_clean_stderr()
+
+    def test_terminal_gone_during_redraw_exits_0(self):
+        """The terminal hangs up while the status line is being rewritten key after key."""
+        self._start_split(self.slave)
+        self.type("i" + "qz" * 40)  # each key rewrites the status line
+        os.close(self.master)
+        self.master = None
+        self.assertEqual(self.wait_exit(), 0, self.stderr_text())
+        msgs = self.msgs.all()
+        self.assertTrue(msgs, "no Twist at all")
+        self.assertEqual(msgs[-1][1:], (0.0,) * 6, "the last Twist is not the final stop")
+        self.assertEqual(sum(1 for m in msgs if m[1:] == (0.0,) * 6), 1, "expected exactly one zero Twist")
+        self.assert_clean_stderr()
 
     def test_remap_moves_the_topic(self):
         self.start(f"cmd_vel:={REMAPPED}", sub=self.remapped_sub)

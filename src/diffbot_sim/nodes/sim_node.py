@@ -34,7 +34,7 @@ from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
 from .. import config as cfgmod
-from .. import ros_msgs
+from .. import ros_msgs, streams
 from ..controller import DiffDriveController, non_finite_field
 from ..description import load_file, parse_args, resolve_meshes
 from ..errors import DiffbotSimError, ModelError
@@ -620,7 +620,18 @@ def _own_the_clock():
 
 
 def main(argv=None):
-    """Entry point of ``rosrun diffbot_sim bullet_sim``. Exits 1 with one line on bad input."""
+    """Entry point of ``rosrun diffbot_sim bullet_sim``. Exits 1 with one line on bad input.
+
+    Output that cannot be written (roslaunch's terminal closed, a pipe whose reader left) never changes the
+    exit status: :func:`diffbot_sim.streams.finish` empties the buffers first.
+    """
+    try:
+        return _main()
+    finally:
+        streams.finish()
+
+
+def _main():
     rospy.init_node("bullet_sim")
     owns_clock = _own_the_clock()
     try:

@@ -33,7 +33,7 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
 from ..errors import ConfigError, TerminalError
-from .. import ros_msgs
+from .. import ros_msgs, streams
 from ..keymap import BANNER, STOP, Teleop, TeleopConfig, format_status
 from ..kinematics import yaw_from_quaternion
 from ..terminal import EOF, StatusLine, raw_terminal, read_key, require_tty
@@ -49,12 +49,24 @@ _SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
 def main():
-    """Run the node; return the process exit status."""
+    """Run the node; return the process exit status.
+
+    Output that cannot be written (a hung-up terminal, ``teleop_key | head -1``) never changes the status:
+    :func:`diffbot_sim.streams.finish` empties the buffers before the interpreter's own final flush would
+    fail with status 120.
+    """
+    try:
+        return _main()
+    finally:
+        streams.finish()
+
+
+def _main():
     stdin = 0
     try:
         require_tty(stdin)
     except TerminalError as err:
-        sys.stderr.write(f"{err}\n")
+        streams.write(sys.stderr, f"{err}\n")
         return 2
     signals = _SignalFlag()
     signals.install()
@@ -104,7 +116,7 @@ def _setup():
 def _run(stdin, teleop, out, odom, signals):
     """The key loop; returns why it ended. The final stop is sent before the terminal is restored."""
     status = StatusLine(sys.stdout)
-    print(BANNER, flush=True)
+    streams.write(sys.stdout, BANNER + "\n")
     reason = "exception"
     with raw_terminal(stdin):
         try:
