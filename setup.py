@@ -2,4 +2,4 @@
 from setuptools import setup
 from catkin_pkg.python_setup import generate_distutils_setup
 
-setup(**generate_distutils_setup(packages=["diffbot_sim", "diffbot_sim.nodes"], package_dir={"": "src"}))
+setup(**generate_distutils_setup(packages=["diffbot_sim", "diffbot_sim.nodes", "diffbot_sim.plugins"], package_dir={"": "src"}))

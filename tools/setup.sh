@@ -52,6 +52,21 @@ if [ ! -x "$VENV/bin/python" ] || [ "$(cat "$STAMP" 2>/dev/null)" != "$want_sha"
   echo "$want_sha" > "$STAMP"
 fi
 
+# Launch files run `xacro file.xacro`: it must be xacro 1.13.3 plus diffbot_sim.xacro_compat (noetic's
+# features), not pip's bare entry point. pip rewrites .venv/bin/xacro whenever it (re)installs xacro, so
+# compare the content on every run instead of trusting the requirements stamp. src/ is a fallback import
+# path for when the workspace is not sourced.
+XACRO_BIN="$VENV/bin/xacro"
+XACRO_LAUNCHER="#!$VENV/bin/python
+import sys; sys.path.append('$ROOT/src')
+from diffbot_sim.xacro_compat import main; sys.exit(main())"
+if [ "$(cat "$XACRO_BIN" 2>/dev/null)" != "$XACRO_LAUNCHER" ]; then
+  log "installing the xacro launcher (xacro 1.13.3 + diffbot_sim.xacro_compat) as $XACRO_BIN"
+  printf '%s\n' "$XACRO_LAUNCHER" > "$XACRO_BIN.tmp"
+  chmod 755 "$XACRO_BIN.tmp"
+  mv -f "$XACRO_BIN.tmp" "$XACRO_BIN"
+fi
+
 # catkin_ws/src/diffbot_sim is a real directory whose entries link to the root's package files. A link to
 # the root itself would be a loop that roslib and rosrun walk into (each file found many times).
 PKG_LINK="$WS/src/diffbot_sim"

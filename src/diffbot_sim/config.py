@@ -71,6 +71,50 @@ class DriveConfig:
         return self.wheel_diameter / 2.0
 
 
+#: gazebo_ros_skid_steer_drive (ROS 1): its tags as DriveConfig keys, and the defaults that differ from the
+#: diff drive's (it broadcasts no TF unless asked, always reports the world pose, has no acceleration limit).
+SKID_STEER_TAGS = {
+    "leftFrontJoint": "left_front", "leftRearJoint": "left_rear", "rightFrontJoint": "right_front",
+    "rightRearJoint": "right_rear", "wheelSeparation": "wheel_separation", "wheelDiameter": "wheel_diameter",
+    "torque": "max_wheel_torque", "commandTopic": "command_topic", "odometryTopic": "odometry_topic",
+    "odometryFrame": "odometry_frame", "robotBaseFrame": "robot_base_frame", "updateRate": "update_rate",
+    "broadcastTF": "publish_odom_tf", "covariance_x": "covariance_x", "covariance_y": "covariance_y",
+    "covariance_yaw": "covariance_yaw", "robotNamespace": "namespace",
+}
+SKID_STEER_DEFAULTS = {"left_front": "left_front_joint", "left_rear": "left_rear_joint",
+                       "right_front": "right_front_joint", "right_rear": "right_rear_joint",
+                       "wheel_separation": 0.4, "wheel_diameter": 0.15, "publish_odom_tf": False,
+                       "covariance_x": 1e-4, "covariance_y": 1e-4, "covariance_yaw": 0.01}
+
+
+def skid_steer_config(model, values, path):
+    """DriveConfig of a gazebo_ros_skid_steer_drive block: ``values`` maps its tags to their texts.
+
+    Raises:
+        ConfigError, ModelError: as :func:`drive_config`.
+    """
+    merged = dict(SKID_STEER_DEFAULTS)
+    for tag, text in values.items():
+        if tag in SKID_STEER_TAGS:
+            merged[SKID_STEER_TAGS[tag]] = text
+    cfg = DriveConfig(odometry_source="world")
+    for key, value in merged.items():
+        label = f"<{key}> of {path}"
+        if key in ("left_front", "left_rear", "right_front", "right_rear"):
+            continue
+        setattr(cfg, key, _drive_value(key, value, label))
+    cfg.left_joints = [_string(f"<leftFrontJoint> of {path}", merged["left_front"]),
+                       _string(f"<leftRearJoint> of {path}", merged["left_rear"])]
+    cfg.right_joints = [_string(f"<rightFrontJoint> of {path}", merged["right_front"]),
+                        _string(f"<rightRearJoint> of {path}", merged["right_rear"])]
+    for jname in cfg.left_joints + cfg.right_joints:
+        joint = model.joint(jname, path)
+        if not joint.movable:
+            raise ModelError(f"skid-steer wheel joint '{jname}' is {joint.type}, not a revolute/continuous joint",
+                             model.source, f"/robot/joint[@name='{jname}']")
+    return cfg
+
+
 #: The ROS 2 plugin publishes nothing unless asked (its publish_odom / publish_odom_tf default false).
 ROS2_DRIVE_DEFAULTS = {"publish_odom": False, "publish_odom_tf": False}
 

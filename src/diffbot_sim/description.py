@@ -7,6 +7,7 @@ lazily so the rest of the package stays importable without them.
 import os
 import xml.etree.ElementTree as ET
 
+from . import xacro_compat
 from .errors import ModelError
 
 
@@ -24,8 +25,12 @@ def parse_args(text):
 def load_file(path, args=None):
     """Read ``path``; run xacro on it when it is a .xacro file. Returns URDF text.
 
+    xacro is 1.13.3 patched by ``xacro_compat`` (noetic's ``xacro.``/``python.``/``math.`` symbols, safe
+    ``load_yaml``, noetic's macro defaults, ``$(dirname)``), so noetic descriptions load as they do in ROS.
+
     Raises:
-        ModelError: the file is missing or unreadable, or xacro fails (the message names the file).
+        ModelError: the file is missing or unreadable, xacro fails, or the installed xacro is not the
+            1.13.x the compatibility layer patches (the message names the file).
     """
     if not os.path.isfile(path):
         raise ModelError("no such file", path)
@@ -35,7 +40,7 @@ def load_file(path, args=None):
                 return handle.read()
         except (OSError, UnicodeDecodeError) as err:
             raise ModelError(f"cannot read ({err})", path) from None
-    import xacro  # lazy: only xacro files need it
+    xacro = xacro_compat.apply()  # lazy import of xacro: only xacro files need it; idempotent
 
     try:
         doc = xacro.process_file(path, mappings=dict(args or {}))

@@ -12,6 +12,18 @@ from typing import Dict, List, Optional, Tuple
 
 from .errors import ModelError
 
+#: Per-link ``<gazebo reference>`` tags that carry a number (ODE surface and contact parameters).
+SURFACE_NUMBERS = ("mu1", "mu2", "kp", "kd", "minDepth", "maxVel", "laserRetro")
+
+
+def tag_value(element):
+    """The value of a Gazebo tag in either form: ``<mu1>0.5</mu1>`` or ``<mu1 value="0.5"/>``."""
+    text = (element.text or "").strip()
+    if not text and element.get("value") is not None:
+        text = element.get("value").strip()
+    return text
+
+
 #: Joint interfaces a transmission may declare (ros_control's, without the ``hardware_interface/`` prefix).
 JOINT_INTERFACES = ("VelocityJointInterface", "EffortJointInterface", "PositionJointInterface")
 
@@ -104,6 +116,8 @@ class RobotModel:
     transmissions: List[Transmission]
     gazebo: List[GazeboBlock]
     root: str
+    warnings: List[str] = field(default_factory=list)  # published mistakes survived, one line each
+    _surfaces: Dict[str, dict] = field(default_factory=dict, repr=False)
 
     def joint(self, name, referrer):
         """Return joint ``name`` or raise ModelError naming ``referrer`` (the element that asked for it)."""
@@ -118,15 +132,29 @@ class RobotModel:
         return sum(link.mass or 0.0 for link in self.links.values())
 
     def surface(self, link):
-        """Gazebo surface tags (mu1, mu2, kp, kd, ...) given in ``<gazebo reference=link>``, as floats."""
+        """Gazebo surface tags given in ``<gazebo reference=link>``: {tag: float} for the numeric ones
+        (SURFACE_NUMBERS), ``fdir1`` as a 3-tuple. Text form ``<mu1>0.5</mu1>`` and attribute form
+        ``<mu1 value="0.5"/>`` are both read, as Gazebo's URDF reader does. A value that is not a number is
+        skipped (recorded in ``warnings``), as Gazebo goes on with its default."""
+        if link in self._surfaces:
+            return dict(self._surfaces[link])
         values = {}
         for block in self.gazebo:
             if block.reference != link:
                 continue
             for child in block.element:
-                if child.tag in ("mu1", "mu2", "kp", "kd", "minDepth", "maxVel"):
-                    values[child.tag] = _float(child.text, self.source, f"{block.path}/{child.tag}")
-        return values
+                if child.tag not in SURFACE_NUMBERS and child.tag != "fdir1":
+                    continue
+                text = tag_value(child)
+                try:
+                    if child.tag == "fdir1":
+                        values["fdir1"] = _vec(text, self.source, f"{block.path}/fdir1")
+                    else:
+                        values[child.tag] = _float(text, self.source, f"{block.path}/{child.tag}")
+                except ModelError as err:
+                    self.warnings.append(f"{err}; ignored (Gazebo's default applies)")
+        self._surfaces[link] = values
+        return dict(values)
 
     def wheel_radius(self, joint_name, referrer):
         """Radius [m] of the wheel driven by ``joint_name``: its child link's cylinder or sphere collision.
@@ -217,6 +245,8 @@ def parse_urdf(text, source="robot_description"):
     for index, el in enumerate(root.findall("gazebo"), start=1):
         ref = el.get("reference")
         path = f"/robot/gazebo[@reference='{ref}']" if ref else f"/robot/gazebo[{index}]"
+        if ref and ref not in links and ref not in joints:
+            model.warnings.append(f"{source}: {path} names no link or joint of the model; its tags are ignored")
         model.gazebo.append(GazeboBlock(ref, el, path))
     return model
 

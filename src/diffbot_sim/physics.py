@@ -5,15 +5,20 @@ worlds side by side) and is used from one thread. Robots are loaded from URDF te
 plain numbers, in URDF link frames (not PyBullet's centre-of-mass frames).
 """
 import contextlib
+import math
 import os
 import tempfile
 import xml.etree.ElementTree as ET
 
+from . import lumping
 from .errors import ModelError
 
-#: Mass [kg] given to a root link that has no <inertial>. PyBullet would give it 1 kg (a phantom kilo
-#: that changes how the robot drives); 0 would make the base static. One milligram changes nothing.
-ROOT_PLACEHOLDER_MASS = 1e-6
+#: Gazebo's friction coefficient for a surface that gives none (SDF <surface><friction><ode><mu> default).
+GAZEBO_DEFAULT_MU = 1.0
+#: Gazebo's contact stiffness [N/m] and damping [N·s/m] defaults (SDF <ode><kp>/<kd>), used to complete a
+#: link that gives only one of the two.
+GAZEBO_DEFAULT_KP = 1e12
+GAZEBO_DEFAULT_KD = 1.0
 
 
 @contextlib.contextmanager
@@ -37,18 +42,6 @@ def _quiet(fd):
 with _quiet(1), _quiet(2):
     import pybullet
     import pybullet_data
-
-
-def prepare_urdf(text, root_link):
-    """Return URDF text PyBullet can load faithfully: a root link without <inertial> gets a 1 mg one."""
-    root = ET.fromstring(text)
-    for link in root.findall("link"):
-        if link.get("name") == root_link and link.find("inertial") is None:
-            inertial = ET.SubElement(link, "inertial")
-            ET.SubElement(inertial, "origin", xyz="0 0 0", rpy="0 0 0")
-            ET.SubElement(inertial, "mass", value=repr(ROOT_PLACEHOLDER_MASS))
-            ET.SubElement(inertial, "inertia", ixx="1e-12", ixy="0", ixz="0", iyy="1e-12", iyz="0", izz="1e-12")
-    return ET.tostring(root, encoding="unicode")
 
 
 class World:
@@ -78,20 +71,24 @@ class World:
         self.plane = pybullet.loadURDF("plane.urdf", physicsClientId=c)
 
     def load_robot(self, urdf_text, model, position=(0.0, 0.0, 0.0), yaw=0.0):
-        """Load a robot; returns a Robot. ``model`` is the parsed RobotModel of the same text."""
-        prepared = prepare_urdf(urdf_text, model.root)
+        """Load a robot; returns a Robot. ``model`` is the parsed RobotModel of the same text.
+
+        Fixed links are lumped as Gazebo lumps them (:mod:`diffbot_sim.lumping`), not by PyBullet's
+        URDF_MERGE_FIXED_LINKS, which would give inertia-less links 1 kg and a merged body one friction.
+        """
+        prepared = lumping.lump(urdf_text, model.root, model.surface)
         handle, path = tempfile.mkstemp(prefix=f"{model.name or 'robot'}_", suffix=".urdf")
         with os.fdopen(handle, "w") as out:
-            out.write(prepared)
+            out.write(prepared.text)
         self._files.append(path)
-        flags = (pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_MERGE_FIXED_LINKS
-                 | pybullet.URDF_USE_IMPLICIT_CYLINDER)
+        flags = pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_USE_IMPLICIT_CYLINDER
         orientation = pybullet.getQuaternionFromEuler((0.0, 0.0, yaw))
         with _quiet(1):
             body = pybullet.loadURDF(path, position, orientation, flags=flags, physicsClientId=self.client)
         if body < 0:
             raise ModelError("PyBullet could not load the model", model.source)
-        robot = Robot(self.client, body, model, position, orientation)
+        robot = Robot(self.client, body, model, position, orientation, prepared.frames)
+        robot.gravity = self.gravity
         self.robots.append(robot)
         return robot
 
@@ -116,8 +113,11 @@ class World:
 class Robot:
     """One loaded robot body: joint lookup, motors, state read-out. Created by ``World.load_robot``."""
 
-    def __init__(self, client, body, model, position, orientation):
+    def __init__(self, client, body, model, position, orientation, frames=None):
         self.client = client
+        self.frames = dict(frames or {})  # URDF link -> (PyBullet link carrying it, xyz, quaternion)
+        self.gravity = -9.81  # set by World.load_robot
+        self._last_velocity = None
         self.body = body
         self.model = model
         self.spawn = (tuple(position), tuple(orientation))
@@ -137,12 +137,34 @@ class Robot:
         self.free_joints(list(self.joint_index.values()))
 
     def _apply_surfaces(self):
-        """Gazebo's per-link <mu1>/<mu2> become PyBullet's lateral friction (it has one coefficient)."""
+        """Each PyBullet link gets the Gazebo surface of the URDF link it is (lumping only merged links of
+        equal surface): friction from mu1/mu2 (PyBullet has one coefficient per link: the lower one),
+        Gazebo's default 1.0 when none is given; kp/kd as contact stiffness/damping."""
         for link, index in self._link_index.items():
             surface = self.model.surface(link)
-            if "mu1" in surface or "mu2" in surface:
-                mu = min(surface.get("mu1", surface.get("mu2")), surface.get("mu2", surface.get("mu1")))
-                pybullet.changeDynamics(self.body, index, lateralFriction=mu, physicsClientId=self.client)
+            mus = [surface[k] for k in ("mu1", "mu2") if k in surface]
+            options = {"lateralFriction": min(mus) if mus else GAZEBO_DEFAULT_MU}
+            if "kp" in surface or "kd" in surface:
+                kp = surface.get("kp", GAZEBO_DEFAULT_KP)
+                kd = surface.get("kd", GAZEBO_DEFAULT_KD)
+                if kp > 0:
+                    options.update(contactStiffness=kp, contactDamping=max(kd, 0.0))
+            pybullet.changeDynamics(self.body, index, physicsClientId=self.client, **options)
+
+    def link_pose(self, name):
+        """World pose ((x, y, z), (qx, qy, qz, qw)) of URDF link ``name``'s frame, lumped or not.
+
+        Raises:
+            KeyError: the model has no such link.
+        """
+        carrier, xyz, quat = self.frames[name] if self.frames else (name, (0, 0, 0), (0, 0, 0, 1))
+        index = self._link_index[carrier]
+        if index == -1:
+            base = self.base_pose()
+        else:
+            state = pybullet.getLinkState(self.body, index, physicsClientId=self.client)
+            base = (state[4], state[5])
+        return pybullet.multiplyTransforms(base[0], base[1], xyz, quat)
 
     def indices(self, names):
         return [self.joint_index[name] for name in names]
@@ -200,6 +222,30 @@ class Robot:
         local_v, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, v, (0, 0, 0, 1))
         local_w, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, angular, (0, 0, 0, 1))
         return tuple(local_v), tuple(local_w)
+
+    def base_acceleration(self, pose, dt):
+        """What an accelerometer on the base reads [m/s^2], in the base frame: the change of the base's
+        velocity since the previous call over ``dt``, minus gravity (so +9.81 on z at rest, REP 145)."""
+        linear, _ = pybullet.getBaseVelocity(self.body, physicsClientId=self.client)
+        previous, self._last_velocity = self._last_velocity, linear
+        if previous is None or dt <= 0:
+            accel = [0.0, 0.0, 0.0]
+        else:
+            accel = [(linear[i] - previous[i]) / dt for i in range(3)]
+        accel[2] -= self.gravity
+        _, inverse = pybullet.invertTransform((0, 0, 0), pose[1])
+        local, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, accel, (0, 0, 0, 1))
+        return tuple(local)
+
+    def set_planar_velocity(self, vx, vy, wz):
+        """Holonomic body velocity (gazebo_ros_planar_move): ``vx, vy`` [m/s] in the base frame's heading,
+        ``wz`` [rad/s] about the world z. The vertical velocity is left to gravity and contacts."""
+        linear, _ = pybullet.getBaseVelocity(self.body, physicsClientId=self.client)
+        _, orientation = self.base_pose()
+        yaw = pybullet.getEulerFromQuaternion(orientation)[2]
+        c, s = math.cos(yaw), math.sin(yaw)
+        pybullet.resetBaseVelocity(self.body, (c * vx - s * vy, s * vx + c * vy, linear[2]), (0.0, 0.0, wz),
+                                   physicsClientId=self.client)
 
     def reset(self):
         """Back to the spawn pose with every joint at 0 and at rest."""

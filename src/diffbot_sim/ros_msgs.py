@@ -14,7 +14,7 @@ import struct
 from geometry_msgs.msg import TransformStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import Imu, JointState
 from tf2_msgs.msg import TFMessage
 
 _HEADER = struct.Struct("<3I")  # seq, stamp.secs, stamp.nsecs
@@ -36,16 +36,27 @@ def covariance_diagonal(cov_x, cov_y, cov_yaw):
     return cov
 
 
+def diagonal(values):
+    """6x6 row-major covariance with the six given values on its diagonal."""
+    cov = [0.0] * 36
+    for i, value in enumerate(values):
+        cov[i * 7] = float(value)
+    return cov
+
+
 class PackedOdometry(Odometry):
     """nav_msgs/Odometry with frames and covariance packed once (same type, md5sum and bytes)."""
 
 
-    def __init__(self, frame, child, covariance):
+    def __init__(self, frame, child, covariance, twist_covariance=None):
         super().__init__()
+        twist_covariance = covariance if twist_covariance is None else twist_covariance
         self.header.frame_id, self.child_frame_id = frame, child
-        self.pose.covariance = self.twist.covariance = list(covariance)
+        self.pose.covariance = list(covariance)
+        self.twist.covariance = list(twist_covariance)
         self._frames = _string(frame) + _string(child)
         self._covariance = struct.pack("<36d", *covariance)
+        self._twist_covariance = struct.pack("<36d", *twist_covariance)
 
     def serialize(self, buff):
         h, p, t = self.header, self.pose.pose, self.twist.twist
@@ -56,16 +67,20 @@ class PackedOdometry(Odometry):
         buff.write(self._covariance)
         a, b = t.linear, t.angular
         buff.write(_TWIST.pack(a.x, a.y, a.z, b.x, b.y, b.z))
-        buff.write(self._covariance)
+        buff.write(self._twist_covariance)
 
 
 class OdometryBuilder:
     """Odometry in ``frame`` for ``child``: pose in the odometry frame, twist in the child frame (signed)."""
 
-    def __init__(self, frame, child, cov_x, cov_y, cov_yaw):
+    def __init__(self, frame, child, cov_x, cov_y, cov_yaw, pose_diagonal=None, twist_diagonal=None):
+        """Covariance: x, y, yaw variances on both diagonals (gazebo_ros), or six-value ``pose_diagonal``
+        and ``twist_diagonal`` (diff_drive_controller's parameters), which win when given."""
         self.frame, self.child = frame, child
-        self.covariance = covariance_diagonal(cov_x, cov_y, cov_yaw)
-        self.msg = PackedOdometry(frame, child, self.covariance)
+        self.covariance = (diagonal(pose_diagonal) if pose_diagonal is not None
+                           else covariance_diagonal(cov_x, cov_y, cov_yaw))
+        twist = diagonal(twist_diagonal) if twist_diagonal is not None else self.covariance
+        self.msg = PackedOdometry(frame, child, self.covariance, twist)
 
     def build(self, stamp, position, orientation, linear, angular):
         """The builder's message, refilled: publish it before the next build()."""
@@ -158,6 +173,22 @@ class JointStateBuilder:
         msg.header.stamp = stamp
         msg.position, msg.velocity, msg.effort = positions, velocities, efforts
         return msg
+
+
+def imu(stamp, frame, orientation, angular_velocity, linear_acceleration, covariance=(0.0, 0.0, 0.0)):
+    """sensor_msgs/Imu: orientation (x, y, z, w), angular velocity [rad/s] and linear acceleration
+    [m/s^2] in ``frame``; ``covariance`` gives the three diagonals' value (orientation, rates, accel)."""
+    msg = Imu()
+    msg.header.stamp, msg.header.frame_id = stamp, frame
+    q = msg.orientation
+    q.x, q.y, q.z, q.w = orientation
+    w, a = msg.angular_velocity, msg.linear_acceleration
+    w.x, w.y, w.z = angular_velocity
+    a.x, a.y, a.z = linear_acceleration
+    for field_name, value in zip(("orientation_covariance", "angular_velocity_covariance",
+                                  "linear_acceleration_covariance"), covariance):
+        setattr(msg, field_name, [value, 0.0, 0.0, 0.0, value, 0.0, 0.0, 0.0, value])
+    return msg
 
 
 def clock(stamp):

@@ -3,6 +3,7 @@ import math
 
 import pytest
 
+from diffbot_sim.errors import ConfigError
 from diffbot_sim.odometry import EncoderOdometry, integrate_exact
 
 R, S = 0.032, 0.2  # the seed's wheel radius and separation
@@ -152,3 +153,87 @@ def test_exact_straight_branch_continuous_with_arc_branch():
     near_straight = integrate_exact(0.0, 0.0, 0.2, 1.0, 1.0001e-6)  # arc formula
     straight = integrate_exact(0.0, 0.0, 0.2, 1.0, 0.9999e-6)  # midpoint formula
     assert near_straight == pytest.approx(straight, abs=1e-8)
+
+
+# -- diff_drive_controller's additions: rolling window, per-side radius, open loop, restart ---------------
+
+def test_default_window_is_one_and_radius_is_shared():
+    odom = EncoderOdometry(R, S)
+    assert odom.velocity_window == 1
+    assert odom.radius == odom.left_radius == odom.right_radius == R
+    odom.radius = 0.05  # the old single-radius attribute still sets both sides
+    assert (odom.left_radius, odom.right_radius) == (0.05, 0.05)
+
+
+def test_rolling_window_averages_the_last_estimates():
+    odom = EncoderOdometry(R, S, velocity_window=3)
+    odom.reset(0.0, 0.0, 0.0)
+    angle, t = 0.0, 0.0
+    for speed in (1.0, 1.0, 1.0, 4.0, 4.0, 4.0):  # wheel joint rate [rad/s], 0.1 s per update
+        angle += speed * 0.1
+        t += 0.1
+        odom.update(angle, angle, t)
+        if t == pytest.approx(0.4):
+            assert odom.linear == pytest.approx((1.0 + 1.0 + 4.0) / 3 * R)
+    assert odom.linear == pytest.approx(4.0 * R)  # the window now holds only the new speed
+    assert odom.x == pytest.approx(15.0 * 0.1 * R)  # the pose is not averaged
+
+
+def test_rolling_window_mean_over_fewer_samples_at_start():
+    odom = EncoderOdometry(R, S, velocity_window=10)
+    odom.reset(0.0, 0.0, 0.0)
+    odom.update(1.0, 1.0, 0.1)
+    assert odom.linear == pytest.approx(10.0 * R)  # one sample: its own value, not a tenth of it
+
+
+@pytest.mark.parametrize("bad", [0, -1, 2.5, True, "10"])
+def test_rolling_window_size_validated(bad):
+    with pytest.raises(ConfigError, match="velocity_rolling_window_size"):
+        EncoderOdometry(R, S, velocity_window=bad)
+
+
+def test_per_side_radius_scales_each_wheel():
+    odom = EncoderOdometry(R, S, right_wheel_radius=2 * R)
+    odom.reset(0.0, 0.0, 0.0)
+    odom.update(1.0, 1.0, 1.0)  # same angle, but the right wheel rolls twice as far: a left turn
+    assert odom.yaw == pytest.approx((2 * R - R) / S)
+    assert odom.linear == pytest.approx(1.5 * R)
+    odom.set_wheel_params(2 * S, R)
+    assert (odom.separation, odom.left_radius, odom.right_radius) == (2 * S, R, R)
+
+
+def test_open_loop_integrates_commands():
+    odom = EncoderOdometry(R, S)
+    assert odom.update_open_loop(0.5, 0.0, 1.0) is False  # first call only sets the time
+    assert odom.update_open_loop(0.5, 0.0, 3.0) is True
+    assert (odom.x, odom.y) == pytest.approx((1.0, 0.0))
+    assert (odom.linear, odom.angular) == (0.5, 0.0)
+    odom.update_open_loop(0.5, math.pi / 2, 4.0)  # a quarter circle of radius 1/pi
+    assert odom.yaw == pytest.approx(math.pi / 2)
+    assert odom.x == pytest.approx(1.0 + 1.0 / math.pi)
+    assert odom.y == pytest.approx(1.0 / math.pi)
+    assert odom.update_open_loop(float("nan"), 0.0, 5.0) is False
+    assert math.isfinite(odom.x) and odom.linear == 0.5
+
+
+def test_restart_keeps_pose_and_angles_but_clears_window_and_time():
+    odom = EncoderOdometry(R, S, velocity_window=5)
+    odom.reset(0.0, 0.0, 0.0)
+    odom.update(10.0, 10.0, 1.0)
+    odom.restart(5.0)
+    assert odom.x == pytest.approx(10.0 * R)
+    assert (odom.linear, odom.angular) == (0.0, 0.0)
+    odom.update(11.0, 11.0, 5.5)  # dt measured from the restart, increment from the old angles
+    assert odom.x == pytest.approx(11.0 * R)
+    assert odom.linear == pytest.approx(R / 0.5)
+
+
+def test_restart_before_any_reading_sets_open_loop_time():
+    odom = EncoderOdometry(R, S)
+    odom.restart(2.0)
+    assert odom.update_open_loop(1.0, 0.0, 2.5) is True
+    assert odom.x == pytest.approx(0.5)
+    closed = EncoderOdometry(R, S)
+    closed.restart(2.0)
+    assert closed.update(7.0, 7.0, 2.5) is False  # the first reading is still the starting point
+    assert closed.x == 0.0

@@ -11,7 +11,8 @@ from diffbot_sim.controller import DiffDriveController
 from diffbot_sim.model import parse_urdf
 from diffbot_sim.odometry import EncoderOdometry
 from diffbot_sim.kinematics import yaw_from_quaternion
-from diffbot_sim.physics import ROOT_PLACEHOLDER_MASS, World, prepare_urdf
+from diffbot_sim import lumping
+from diffbot_sim.physics import World
 
 DT = 1.0 / 240.0
 R, S, TORQUE = 0.032, 0.2, 30.0
@@ -63,31 +64,10 @@ def test_loaded_mass_equals_urdf_mass(seed, seed_model):
     assert robot.total_mass() == pytest.approx(1.44, abs=1e-5)
 
 
-def test_without_prepare_urdf_pybullet_adds_a_phantom_kilogram(make_world, seed_urdf, seed_model, monkeypatch):
-    monkeypatch.setattr(physics, "prepare_urdf", lambda text, root: text)
+def test_without_lumping_pybullet_adds_a_phantom_kilogram(make_world, seed_urdf, seed_model, monkeypatch):
+    monkeypatch.setattr(physics.lumping, "lump", lambda text, root, surface: lumping.LumpedUrdf(text, {}))
     robot = make_world().load_robot(seed_urdf, seed_model)
     assert robot.total_mass() == pytest.approx(seed_model.total_mass() + 1.0, abs=1e-5)
-
-
-def test_prepare_urdf_adds_milligram_only_to_inertia_less_root(seed_urdf, seed_model):
-    root = ET.fromstring(prepare_urdf(seed_urdf, seed_model.root))
-    links = {link.get("name"): link for link in root.findall("link")}
-    masses = {name: float(link.find("inertial/mass").get("value"))
-              for name, link in links.items() if link.find("inertial") is not None}
-    assert masses["base_footprint"] == ROOT_PLACEHOLDER_MASS == 1e-6
-    assert masses["base_link"] == pytest.approx(1.0)
-    assert sum(masses.values()) == pytest.approx(1.44 + 1e-6, abs=1e-12)
-    # the prepared text parses to the same model, plus a milligram
-    assert parse_urdf(ET.tostring(root, encoding="unicode")).total_mass() == pytest.approx(1.44 + 1e-6)
-
-
-def test_prepare_urdf_leaves_root_with_inertial_alone(make_urdf):
-    text = make_urdf().replace('<link name="base_footprint"/>',
-                               '<link name="base_footprint"><inertial><mass value="0.5"/>'
-                               '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>')
-    root = ET.fromstring(prepare_urdf(text, "base_footprint"))
-    inertials = root.find("link[@name='base_footprint']").findall("inertial")
-    assert len(inertials) == 1 and inertials[0].find("mass").get("value") == "0.5"
 
 
 def test_surface_friction_applied(seed):

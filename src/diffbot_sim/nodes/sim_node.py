@@ -22,40 +22,24 @@ import os
 import socket
 import threading
 import time
-import warnings
 
 import rospy
-from geometry_msgs.msg import Twist, TwistStamped
 from rosgraph_msgs.msg import Clock
-from nav_msgs.msg import Odometry
-from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64
 from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
 from .. import config as cfgmod
-from .. import ros_msgs, streams
-from ..controller import DiffDriveController, non_finite_field
-from ..description import load_file, parse_args, resolve_meshes
+from .. import meshes, ros_msgs, streams
+from ..description import load_file, parse_args
 from ..errors import DiffbotSimError, ModelError
 from ..model import parse_urdf
-from ..odometry import EncoderOdometry
-from ..kinematics import quaternion_from_yaw
 from ..physics import World
-from ..plugins import read_plugins
+from ..plugins import read_plugins, registry
+from ..plugins.base import RobotContext, next_due, publisher
 from ..throttle import Throttle
 
 _CONTROLLER_SUFFIX = {"VelocityJointInterface": "velocity", "EffortJointInterface": "effort",
                       "PositionJointInterface": "position"}
-
-
-def _publisher(name, msg_class):
-    """A synchronous publisher: publish() writes on the loop's thread. Measured here, rospy's queued
-    publishers cost more CPU (a thread hand-off per message and connection) than the write itself; a
-    stalled subscriber is handled by SubscriberLinks' send timeout instead of by a queue."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", SyntaxWarning)  # rospy warns on queue_size=None, which we mean
-        return rospy.Publisher(name, msg_class, queue_size=None)
 
 
 class SubscriberLinks:
@@ -128,232 +112,50 @@ class SubscriberLinks:
             self.held_since = None
 
 
-def _join(namespace, name):
-    """Resolve ``name`` under a plugin namespace (None: the node's namespace, i.e. a relative name)."""
-    if name.startswith("/") or namespace is None or namespace == "":
-        return name
-    return namespace.rstrip("/") + "/" + name
-
-
 class RobotRuntime:
-    """One robot: its physics body, controller, odometry and ROS endpoints."""
+    """One robot: its physics body and its plugins (one per Gazebo plugin, found through the registry).
 
-    def __init__(self, sim, model, robot, drive, joint_cfg, cfg, spec):
-        self.sim = sim
-        self.spec = spec
-        self.namespace = "/" + spec.name if spec.name else None
-        self.private = f"~{spec.name}/" if spec.name else "~"  # private topics: ~<name>/ground_truth
-        self.model = model
-        self.robot = robot
-        self.drive = drive
-        self.joint_cfg = joint_cfg
-        self.cfg = cfg
-        self.motor_joints = {}  # joint -> transmission (non-drive motors)
-        drive_joints = set(drive.left_joints + drive.right_joints) if drive else set()
-        for trans in model.transmissions:
-            if trans.joint not in drive_joints:
-                self.motor_joints[trans.joint] = trans
-        self.command_subs = []
-        self._joint_commands = {}
-        self._lock = threading.Lock()
-        self._pending_twist = None
-        self.next_odom = 0.0
-        self.next_js = 0.0
-        self.max_wheel_velocity = None
-        self.odom_pub = self.truth_pub = self.debug_pub = self.js_pub = None
-        if drive is not None:
-            self._setup_drive()
-        else:
-            self.controller = None
-        if joint_cfg is not None:
-            self.js_indices = robot.indices(joint_cfg.joints)
-            self.js_names = list(joint_cfg.joints)
-            self.js_pub = _publisher(_join(joint_cfg.namespace, joint_cfg.topic), JointState)
-            self.js_builder = ros_msgs.JointStateBuilder(self.js_names)
-            self.js_period = 1.0 / joint_cfg.update_rate if joint_cfg.update_rate > 0 else 0.0
-        for joint, trans in self.motor_joints.items():
-            suffix = _CONTROLLER_SUFFIX[trans.interface]
-            topic = _join(self.namespace, f"{joint}_{suffix}_controller/command")
-            if trans.interface != "PositionJointInterface":
-                self.robot.free_joints(self.robot.indices([joint]))
-            self.command_subs.append(rospy.Subscriber(topic, Float64, self._on_joint_command,
-                                                      callback_args=joint, queue_size=1))
+    The loop asks it what is due and calls it before and after each step; it knows no plugin by name.
+    """
 
-    # -- drive --------------------------------------------------------------------------------------
-    def _setup_drive(self):
-        drive, cfg, robot = self.drive, self.cfg, self.robot
-        radius = drive.wheel_radius
-        self.max_wheel_velocity = cfgmod.max_wheel_velocity(cfg, robot.model, drive)
-        self.controller = DiffDriveController(drive.wheel_separation, radius, self.max_wheel_velocity,
-                                              drive.max_wheel_acceleration, cfg.cmd_vel_timeout)
-        self.left_idx = robot.indices(drive.left_joints)
-        self.right_idx = robot.indices(drive.right_joints)
-        self.wheel_idx = self.left_idx + self.right_idx
-        self.wheel_forces = cfgmod.wheel_efforts(robot.model, drive)
-        self.update_period = 1.0 / drive.update_rate if drive.update_rate > 0 else 0.0
-        self.next_update = 0.0
-        self.last_update = 0.0
-        self.encoder = EncoderOdometry(radius, drive.wheel_separation)
-        ns = drive.namespace
-        self.cmd_sub = rospy.Subscriber(_join(ns, drive.command_topic), Twist, self._on_twist, queue_size=1)
-        if drive.publish_odom:
-            self.odom_pub = _publisher(_join(ns, drive.odometry_topic), Odometry)
-        self.odom_builder = ros_msgs.OdometryBuilder(drive.odometry_frame, drive.robot_base_frame,
-                                                     drive.covariance_x, drive.covariance_y, drive.covariance_yaw)
-        self.tf_builder = ros_msgs.TransformBuilder(drive.odometry_frame, drive.robot_base_frame)
-        if cfg.publish_ground_truth:
-            self.truth_pub = _publisher(self.private + "ground_truth", Odometry)
-            self.truth_builder = ros_msgs.OdometryBuilder("world", drive.robot_base_frame, 0.0, 0.0, 0.0)
-        if cfg.debug_cmd_applied:
-            self.debug_pub = _publisher(self.private + "debug/cmd_applied", TwistStamped)
-
-    def _on_twist(self, msg):
-        """Subscriber thread: keep the newest *valid* command and wake the loop, which applies it (at once
-        in real time, at the next step in fast mode).
-
-        Validating here (not in the loop) means a burst of a good command followed by a NaN one keeps the
-        good one, as diff_drive_controller does.
-        """
-        values = ros_msgs.twist_values(msg)
-        bad = non_finite_field(values)
-        if bad is not None:
-            self.sim.warn(f"nonfinite:{id(self)}", f"ignored a cmd_vel with a non-finite {bad} {values}; "
-                          "the robot keeps its last valid command")
-            return
-        with self._lock:
-            self._pending_twist = values
-        self.sim.wake.set()
-
-    def _on_joint_command(self, msg, joint):
-        """Subscriber thread: keep the newest finite command per joint (validated here, like cmd_vel)."""
-        if not math.isfinite(msg.data):
-            self.sim.warn(f"joint:{joint}", f"ignored a non-finite command for joint {joint}")
-            return
-        with self._lock:
-            self._joint_commands[joint] = msg.data
-        self.sim.wake.set()
-
-    def take_pending(self):
-        """The newest twist and joint commands since the last call (None, {} when there are none)."""
-        if self._pending_twist is None and not self._joint_commands:
-            return None, {}  # the common case, checked without the lock (attribute reads are atomic)
-        with self._lock:
-            twist, self._pending_twist = self._pending_twist, None
-            joints, self._joint_commands = self._joint_commands, {}
-        return twist, joints
-
-    # -- loop work ----------------------------------------------------------------------------------
-    def before_step(self, now):
-        """Apply new commands and run the controller when due. Called by the loop before each step."""
-        twist, joint_commands = self.take_pending()
-        for joint, value in joint_commands.items():
-            self._apply_joint_command(joint, value)
-        if self.controller is None:
-            return
-        fresh = False
-        if twist is not None:
-            fresh = self.controller.set_command(twist[0], twist[5], now)
-        elif now + 1e-9 < self.next_update:
-            expiry = self.controller.expiry()
-            if expiry is None or now < expiry:
-                return  # nothing new, nothing due: the motors keep their targets
-        _, velocities, _ = self.robot.joint_states(self.wheel_idx)
-        n = len(self.left_idx)
-        left_v = sum(velocities[:n]) / n
-        right_v = sum(velocities[n:]) / n
-        dt = max(now - self.last_update, self.cfg.time_step)
-        left, right = self.controller.update(now, left_v, right_v, dt)
-        self.robot.set_velocities(self.wheel_idx, [left] * n + [right] * n, self.wheel_forces)
-        self.last_update = now
-        if now + 1e-9 >= self.next_update:
-            self.next_update = _next_due(self.next_update, self.update_period, now)
-        if fresh and self.debug_pub is not None:
-            self.debug_pub.publish(ros_msgs.twist_stamped(rospy.Time.from_sec(time.time()), twist[0], twist[5]))
-
-    def _apply_joint_command(self, joint, value):
-        trans = self.motor_joints[joint]
-        idx = self.robot.indices([joint])
-        limit = self.model.joints[joint].effort_limit
-        force = limit if limit else cfgmod.FALLBACK_JOINT_EFFORT
-        if trans.interface == "VelocityJointInterface":
-            self.robot.set_velocities(idx, [value], [force])
-        elif trans.interface == "PositionJointInterface":
-            self.robot.set_positions(idx, [value], [force])
-        else:
-            self.robot.set_efforts(idx, [max(-force, min(force, value))])
+    def __init__(self, ctx, plugins):
+        self.ctx = ctx
+        self.spec = ctx.spec
+        self.model = ctx.model
+        self.robot = ctx.robot
+        self.private = ctx.private
+        self.plugins = plugins
 
     def publishers(self):
         """This robot's publishers that the loop writes to."""
-        return [p for p in (self.odom_pub, self.truth_pub, self.debug_pub, self.js_pub) if p is not None]
+        pubs = []
+        for plugin in self.plugins:
+            pubs += plugin.publishers()
+        return pubs
 
     def next_publish(self):
-        """Sim time of this robot's next odom/TF or joint_states publication."""
-        due = [self.next_odom] if self.controller is not None else []
-        if self.joint_cfg is not None:
-            due.append(self.next_js)
-        return min(due) if due else math.inf
+        """Sim time of this robot's next publication."""
+        return min((p.next_publish() for p in self.plugins), default=math.inf)
 
     def next_due(self):
-        """Sim time of the next thing this robot must do (controller update, odom, joint_states)."""
-        update = self.next_update if self.controller is not None else math.inf
-        return min(update, self.next_publish())
+        """Sim time of the next thing this robot must do (control or publishing)."""
+        return min([p.next_due() for p in self.plugins] + [self.next_publish()], default=math.inf)
+
+    def before_step(self, now):
+        for plugin in self.plugins:
+            plugin.before_step(now)
 
     def after_step(self, now, stamp, transforms):
-        """Publish what is due at sim time ``now``; TF transforms go into ``transforms`` (one TFMessage for
-        every robot is cheaper than one each). Called by the loop after each step."""
-        if self.controller is not None and now + 1e-9 >= self.next_odom:
-            self.next_odom = _next_due(self.next_odom, self.update_period, now)
-            self._publish_odometry(now, stamp, transforms)
-        if self.joint_cfg is not None and now + 1e-9 >= self.next_js:
-            self.next_js = _next_due(self.next_js, self.js_period, now)
-            if self.js_pub.get_num_connections():  # nobody listening: skip the read-out and the message
-                positions, velocities, efforts = self.robot.joint_states(self.js_indices)
-                self.js_pub.publish(self.js_builder.build(stamp, positions, velocities, efforts))
+        for plugin in self.plugins:
+            plugin.after_step(now, stamp, transforms)
 
-    def _publish_odometry(self, now, stamp, transforms):
-        drive = self.drive
-        if self.truth_pub is not None and self.truth_pub.get_num_connections():
-            pose = self.robot.base_pose()
-            linear, angular = self.robot.base_twist(pose)
-            self.truth_pub.publish(self.truth_builder.build(stamp, pose[0], pose[1], linear, angular))
-        if drive.odometry_source == "encoder":
-            positions, _, _ = self.robot.joint_states([self.left_idx[0], self.right_idx[0]])
-            self.encoder.update(positions[0], positions[1], now)
-            enc = self.encoder
-            position = (enc.x, enc.y, 0.0)
-            orientation = quaternion_from_yaw(enc.yaw)
-            linear, angular = (enc.linear, 0.0, 0.0), (0.0, 0.0, enc.angular)
-        else:
-            position, orientation = self.robot.base_pose()
-            linear, angular = self.robot.base_twist((position, orientation))
-        if self.odom_pub is not None and self.odom_pub.get_num_connections():
-            self.odom_pub.publish(self.odom_builder.build(stamp, position, orientation, linear, angular))
-        if drive.publish_odom_tf:
-            transforms.append(self.tf_builder.build(stamp, position, orientation))
+    def reset(self, now):
+        for plugin in self.plugins:
+            plugin.reset(now)
 
-    def reset(self):
-        """Brake and drop pending commands; the caller re-anchors the encoder (start_encoder)."""
-        if self.controller is not None:
-            self.controller.brake()
-            self.robot.set_velocities(self.wheel_idx, [0.0] * len(self.wheel_idx), self.wheel_forces)
-        with self._lock:
-            self._pending_twist = None
-            self._joint_commands = {}
-
-    def start_encoder(self, now):
-        if self.controller is not None:
-            positions, _, _ = self.robot.joint_states([self.left_idx[0], self.right_idx[0]])
-            self.encoder.reset(positions[0], positions[1], now)
-
-
-def _next_due(due, period, now):
-    """Next publish time after ``due``; skips missed slots instead of bursting to catch up."""
-    if period <= 0:
-        return now
-    due += period
-    if due < now:
-        due = now + period
-    return due
+    def start(self, now):
+        for plugin in self.plugins:
+            plugin.start(now)
 
 
 class Simulator:
@@ -368,8 +170,8 @@ class Simulator:
         self._requests_lock = threading.Lock()
         self.steps = 0
         self.world = World(cfg.time_step, cfg.gravity, gui=cfg.gui)
-        self.clock_pub = _publisher("/clock", Clock)
-        self.tf_pub = _publisher("/tf", TFMessage)
+        self.clock_pub = publisher("/clock", Clock)
+        self.tf_pub = publisher("/tf", TFMessage)
         self.robots = []
         self.clock_period = 1.0 / cfg.clock_rate
         self.next_clock = 0.0
@@ -419,8 +221,8 @@ class Simulator:
                 self.world.reset()
                 now = self.sim_time
                 for runtime in self.robots:
-                    runtime.reset()
-                    runtime.start_encoder(now)
+                    runtime.reset(now)
+                    runtime.start(now)
             done.set()
 
     @property
@@ -442,7 +244,7 @@ class Simulator:
         cfg = self.cfg
         dt = cfg.time_step
         for runtime in self.robots:
-            runtime.start_encoder(0.0)
+            runtime.start(0.0)
         self._publish_clock(0.0)
         self._rebase()
         while not rospy.is_shutdown():
@@ -511,7 +313,7 @@ class Simulator:
         if self.clock_pub.get_num_connections():
             self._clock_msg.clock = stamp
             self.clock_pub.publish(self._clock_msg)
-        self.next_clock = _next_due(self.next_clock, self.clock_period, now)
+        self.next_clock = next_due(self.next_clock, self.clock_period, now)
 
     def close(self):
         self.links.release()
@@ -539,25 +341,35 @@ def _load_model(spec):
 class LoadedRobot:
     """What build() learned about one robot, kept for the start-up report."""
 
-    def __init__(self, spec, model, plugins, drive, joint_cfg, runtime):
-        self.spec, self.model, self.plugins = spec, model, plugins
-        self.drive, self.joint_cfg, self.runtime = drive, joint_cfg, runtime
+    def __init__(self, spec, model, plugins, runtime, notes):
+        self.spec, self.model, self.plugins, self.runtime, self.notes = spec, model, plugins, runtime, notes
 
 
 def _build_robot(sim, cfg, spec, params):
     text, source = _load_model(spec)
     model = parse_urdf(text, source)
-    text = resolve_meshes(text, source)
-    plugins = read_plugins(model)
-    drive = cfgmod.drive_config(model, plugins.diff_drive, params)
-    joint_cfg = cfgmod.joint_state_config(model, plugins.joint_state, drive)
-    cfgmod.place_in_namespace(spec, drive, joint_cfg)
+    base_dir = os.path.dirname(source) if os.path.isfile(source) else os.getcwd()
+    text, mesh_notes = meshes.prepare_meshes(text, source, base_dir, meshes.default_cache_dir(),
+                                             _package_path)
+    found = read_plugins(model, known=registry.KNOWN)
     for trans in model.transmissions:
         model.joint(trans.joint, f"/robot/transmission[@name='{trans.name}']")
     robot = sim.world.load_robot(text, model, (spec.x, spec.y, spec.z), spec.yaw)
-    runtime = RobotRuntime(sim, model, robot, drive, joint_cfg, cfg, spec)
+    namespace = "/" + spec.name if spec.name else None
+    ctx = RobotContext(sim, cfg, spec, model, robot, params, namespace, f"~{spec.name}/" if spec.name else "~")
+    runtime = RobotRuntime(ctx, registry.build(ctx, found, params))
     sim.add_robot(runtime)
-    return LoadedRobot(spec, model, plugins, drive, joint_cfg, runtime)
+    return LoadedRobot(spec, model, found, runtime, model.warnings + mesh_notes + ctx.warnings)
+
+
+def _package_path(package):
+    """rospkg's path of ``package`` (LookupError when unknown), for package:// mesh URIs."""
+    import rospkg
+
+    try:
+        return rospkg.RosPack().get_path(package)
+    except rospkg.ResourceNotFound as err:
+        raise LookupError(package) from err
 
 
 def build(cfg, params):
@@ -578,24 +390,23 @@ def _report(cfg, loaded):
     for key, value in cfgmod.as_params(cfg).items():
         rospy.set_param("~" + key, value)
     for item in loaded:
-        plugins, drive, model = item.plugins, item.drive, item.model
+        found, model, runtime = item.plugins, item.model, item.runtime
         who = f"robot {item.spec.name}: " if item.spec.name else ""
-        for text in plugins.warnings:
+        for text in found.warnings + item.notes:
             rospy.logwarn(who + text)
-        if plugins.unsupported:
-            rospy.logwarn(who + "not simulated (ignored): " + "; ".join(plugins.unsupported))
-        for block in (plugins.diff_drive, plugins.joint_state):
+        if found.unsupported:
+            rospy.logwarn(who + "not simulated (ignored): " + "; ".join(found.unsupported))
+        for block in (found.diff_drive, found.joint_state):
             if block is not None and block.unknown_tags:
                 rospy.logwarn(f"{who}{block.path}: unknown tags ignored: {', '.join(block.unknown_tags)}")
-        if drive is None:
-            rospy.logwarn(who + "the model has no gazebo_ros_diff_drive plugin (and no ~left_joints): nothing "
-                          "subscribes cmd_vel")
+        if not any(p.joints() or p.filename == "libgazebo_ros_planar_move.so" for p in runtime.plugins):
+            rospy.logwarn(who + "the model has no drive plugin or controller that bullet_sim simulates (and no "
+                          "~left_joints): nothing moves it")
         params = {}
-        if drive is not None:
-            params.update(cfgmod.as_params(drive))
-            params["wheel_radius"] = drive.wheel_radius
-            params["effective_max_wheel_velocity"] = item.runtime.max_wheel_velocity
-        params["loaded_mass"] = item.runtime.robot.total_mass()
+        for plugin in runtime.plugins:
+            params.update(plugin.summary())
+        params["plugins"] = ",".join(p.filename for p in runtime.plugins)
+        params["loaded_mass"] = runtime.robot.total_mass()
         params["urdf_mass"] = model.total_mass()
         if item.spec.name:
             params.update({k: v for k, v in cfgmod.as_params(item.spec).items() if k != "name"})

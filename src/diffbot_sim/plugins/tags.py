@@ -7,10 +7,11 @@ defaults and validation live in :mod:`diffbot_sim.config`, so a tag, a ROS param
 merged in one place.
 """
 import re
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional
 
-from .errors import ModelError
+from ..errors import ModelError
 
 DIFF_DRIVE = "libgazebo_ros_diff_drive.so"
 JOINT_STATE = "libgazebo_ros_joint_state_publisher.so"
@@ -60,15 +61,28 @@ class PluginBlock:
 
 
 @dataclass
+class PluginElement:
+    """A ``<plugin>`` of the model other than the diff drive and joint-state publisher (read here)."""
+
+    filename: str  # normalised: libNAME.so
+    name: str
+    element: ET.Element
+    path: str
+
+
+@dataclass
 class Plugins:
     diff_drive: Optional[PluginBlock] = None
     joint_state: Optional[PluginBlock] = None
+    others: List[PluginElement] = field(default_factory=list)  # every other plugin, in model order
     unsupported: List[str] = field(default_factory=list)  # plugins and sensors we do not simulate
     warnings: List[str] = field(default_factory=list)
 
 
-def read_plugins(model):
-    """Collect the diff-drive and joint-state plugin blocks of ``model`` (a RobotModel).
+def read_plugins(model, known=NATIVE):
+    """Collect the plugin blocks of ``model`` (a RobotModel): the diff drive and joint-state publisher read
+    into PluginBlocks, every other plugin as a PluginElement; those whose filename is not in ``known``
+    (nor one of the two) are also named in ``unsupported``.
 
     Raises:
         ModelError: a plugin without a filename.
@@ -94,8 +108,10 @@ def read_plugins(model):
                     found.warnings.append(f"{path}: a second joint-state plugin is ignored")
                     continue
                 found.joint_state = _read_joint_state(el, path)
-            elif base not in NATIVE:
-                found.unsupported.append(f"plugin {name} ({filename})")
+            else:
+                found.others.append(PluginElement(base, name, el, path))
+                if base not in known:
+                    found.unsupported.append(f"plugin {name} ({filename})")
         for el in block.element.iter("sensor"):
             found.unsupported.append(f"sensor {el.get('name') or '?'} (type {el.get('type') or '?'})")
     return found

@@ -1,0 +1,476 @@
+"""ros_controllers' diff_drive_controller/DiffDriveController (noetic), as a pure per-update core.
+
+Robots built for Gazebo + gazebo_ros_control load a DiffDriveController from their YAML; to run them
+unchanged the simulator must read the same parameters and move the wheels and integrate odometry the way
+the controller does. This module holds that logic with time passed in as float seconds: ``ddc_config``
+turns the controller's parameter dict (``rospy.get_param('/mobile_base_controller')``) into a validated
+``DdcConfig``, and ``DiffDriveControllerCore`` runs one control cycle per ``update``. Publishing odom, TF and
+``cmd_vel_out`` and reading the URDF for missing geometry belong to the caller.
+"""
+import math
+from dataclasses import asdict, dataclass, field
+from typing import NamedTuple, Optional, Tuple
+
+from .errors import ConfigError
+from .kinematics import wheel_speeds
+from .limits import SpeedLimiter
+from .odometry import EncoderOdometry
+
+CONTROLLER_TYPE = "diff_drive_controller/DiffDriveController"
+
+_TOP_LEVEL_KEYS = frozenset((
+    "type", "left_wheel", "right_wheel", "wheel_separation", "wheel_radius", "wheel_separation_multiplier",
+    "wheel_radius_multiplier", "left_wheel_radius_multiplier", "right_wheel_radius_multiplier", "publish_rate",
+    "pose_covariance_diagonal", "twist_covariance_diagonal", "open_loop", "velocity_rolling_window_size",
+    "cmd_vel_timeout", "allow_multiple_cmd_vel_publishers", "base_frame_id", "odom_frame_id", "enable_odom_tf",
+    "publish_cmd", "publish_wheel_joint_controller_state", "linear", "angular",
+))
+_LIMIT_FLAGS = ("has_velocity_limits", "has_acceleration_limits", "has_jerk_limits")
+_LIMIT_PAIRS = (("velocity", "has_velocity_limits"), ("acceleration", "has_acceleration_limits"),
+                ("jerk", "has_jerk_limits"))
+
+
+@dataclass(frozen=True)
+class AxisLimits:
+    """One axis's ``linear/x/*`` or ``angular/z/*`` limits; field names are the parameter names.
+
+    The ``min_*`` values are already resolved (upstream's default is ``-max_*``), so ``SpeedLimiter(**asdict())``
+    builds the limiter.
+    """
+
+    has_velocity_limits: bool = False
+    has_acceleration_limits: bool = False
+    has_jerk_limits: bool = False
+    min_velocity: float = 0.0
+    max_velocity: float = 0.0
+    min_acceleration: float = 0.0
+    max_acceleration: float = 0.0
+    min_jerk: float = 0.0
+    max_jerk: float = 0.0
+
+    def limiter(self):
+        """A fresh ``SpeedLimiter`` with these limits."""
+        return SpeedLimiter(**asdict(self))
+
+
+@dataclass(frozen=True)
+class DdcConfig:
+    """A DiffDriveController's parameters, validated, with the noetic defaults filled in.
+
+    ``wheel_separation`` and ``wheel_radius`` are None when the YAML leaves them to the URDF; the caller
+    measures them and hands them to ``DiffDriveControllerCore``. ``unknown_keys`` are full parameter names
+    upstream never reads (vendor keys such as ``k_l``), for one warning; ``unsupported`` are parameters read
+    but not acted on here; ``warnings`` are ready-to-log sentences (defaults substituted, values fixed up).
+    """
+
+    name: str
+    left_wheels: Tuple[str, ...]
+    right_wheels: Tuple[str, ...]
+    wheel_separation: Optional[float] = None
+    wheel_radius: Optional[float] = None
+    wheel_separation_multiplier: float = 1.0
+    left_wheel_radius_multiplier: float = 1.0
+    right_wheel_radius_multiplier: float = 1.0
+    publish_rate: float = 50.0
+    pose_covariance_diagonal: Tuple[float, ...] = (0.0,) * 6
+    twist_covariance_diagonal: Tuple[float, ...] = (0.0,) * 6
+    open_loop: bool = False
+    velocity_rolling_window_size: int = 10
+    cmd_vel_timeout: float = 0.5
+    allow_multiple_cmd_vel_publishers: bool = True
+    base_frame_id: str = "base_link"
+    odom_frame_id: str = "odom"
+    enable_odom_tf: bool = True
+    publish_cmd: bool = False
+    publish_wheel_joint_controller_state: bool = False
+    linear: AxisLimits = field(default_factory=AxisLimits)
+    angular: AxisLimits = field(default_factory=AxisLimits)
+    unknown_keys: Tuple[str, ...] = ()
+    unsupported: Tuple[str, ...] = ()
+    warnings: Tuple[str, ...] = ()
+
+    @property
+    def publish_period(self):
+        """Seconds between odom publications; ``inf`` for ``publish_rate: 0`` (never, as upstream's 1/0)."""
+        return math.inf if self.publish_rate == 0 else 1.0 / self.publish_rate
+
+    @property
+    def joints(self):
+        """Every wheel joint the controller commands, left ones first."""
+        return self.left_wheels + self.right_wheels
+
+
+def ddc_config(params, name):
+    """Build a ``DdcConfig`` from the controller's parameter dict.
+
+    Args:
+        params: the controller namespace as rospy returns it, e.g. ``rospy.get_param('/mobile_base_controller')``:
+            nested dicts (``{'linear': {'x': {...}}}``), ints wherever a float is expected are fine.
+        name: the controller namespace (``/mobile_base_controller``), used to name parameters in errors.
+
+    Returns:
+        DdcConfig.
+
+    Raises:
+        ConfigError: naming the full parameter (``/mobile_base_controller/left_wheel``) whose value is
+            missing, of the wrong type or out of range.
+    """
+    ns = name.rstrip("/")
+    if not isinstance(params, dict):
+        raise ConfigError(ns, params, "a mapping of the DiffDriveController's parameters")
+    warnings, unsupported = [], []
+    unknown = [f"{ns}/{key}" for key in params if key not in _TOP_LEVEL_KEYS]
+
+    def pname(key):
+        return f"{ns}/{key}"
+
+    kind = params.get("type", CONTROLLER_TYPE)
+    if kind != CONTROLLER_TYPE:
+        raise ConfigError(pname("type"), kind, repr(CONTROLLER_TYPE))
+
+    left = _wheel_names(pname("left_wheel"), params.get("left_wheel"))
+    right = _wheel_names(pname("right_wheel"), params.get("right_wheel"))
+    if len(left) != len(right):
+        raise ConfigError(pname("right_wheel"), params["right_wheel"],
+                          f"as many joints as {pname('left_wheel')} ({len(left)})")
+
+    def number(key, default, **bounds):
+        if key not in params:
+            return default
+        return _number(pname(key), params[key], **bounds)
+
+    def flag(key, default):
+        if key not in params:
+            return default
+        return _bool(pname(key), params[key])
+
+    values = {
+        "wheel_separation": number("wheel_separation", None, low=0.0, low_open=True),
+        "wheel_radius": number("wheel_radius", None, low=0.0, low_open=True),
+        "wheel_separation_multiplier": number("wheel_separation_multiplier", 1.0, low=0.0, low_open=True),
+        "publish_rate": number("publish_rate", 50.0, low=0.0),
+        "open_loop": flag("open_loop", False),
+        "cmd_vel_timeout": number("cmd_vel_timeout", 0.5, low=0.0, allow_inf=True),
+        "allow_multiple_cmd_vel_publishers": flag("allow_multiple_cmd_vel_publishers", True),
+        "enable_odom_tf": flag("enable_odom_tf", True),
+        "publish_cmd": flag("publish_cmd", False),
+        "publish_wheel_joint_controller_state": flag("publish_wheel_joint_controller_state", False),
+    }
+    if values["publish_wheel_joint_controller_state"]:
+        unsupported.append(pname("publish_wheel_joint_controller_state"))
+        warnings.append(f"{pname('publish_wheel_joint_controller_state')} is true, but the simulator does not "
+                        "publish ~wheel_joint_controller_state")
+
+    window = params.get("velocity_rolling_window_size", 10)
+    if (isinstance(window, bool) or not isinstance(window, (int, float)) or not math.isfinite(window)
+            or window != int(window) or window < 1):
+        raise ConfigError(pname("velocity_rolling_window_size"), window, "an integer >= 1")
+    values["velocity_rolling_window_size"] = int(window)
+
+    # wheel_radius_multiplier, when set, wins over the per-side ones (upstream's precedence).
+    sides = ("left_wheel_radius_multiplier", "right_wheel_radius_multiplier")
+    side_values = {key: number(key, 1.0, low=0.0, low_open=True) for key in sides}
+    if "wheel_radius_multiplier" in params:
+        both = _number(pname("wheel_radius_multiplier"), params["wheel_radius_multiplier"], low=0.0, low_open=True)
+        for key in sides:
+            if key in params and side_values[key] != both:
+                warnings.append(f"{pname(key)} ({side_values[key]:g}) is ignored: "
+                                f"{pname('wheel_radius_multiplier')} ({both:g}) overrides it")
+            values[key] = both
+    else:
+        values.update(side_values)
+
+    for key in ("pose_covariance_diagonal", "twist_covariance_diagonal"):
+        if key in params:
+            values[key] = _covariance(pname(key), params[key])
+        else:
+            values[key] = (0.0,) * 6
+            warnings.append(f"{pname(key)} is not set (diff_drive_controller requires it); using zeros")
+
+    for key, default in (("base_frame_id", "base_link"), ("odom_frame_id", "odom")):
+        frame = params.get(key, default)
+        if not isinstance(frame, str) or not frame.strip("/"):
+            raise ConfigError(pname(key), frame, "a non-empty TF frame id such as " + default)
+        if frame.startswith("/"):
+            warnings.append(f"{pname(key)} {frame!r}: tf2 frame ids take no leading slash; "
+                            f"using {frame.lstrip('/')!r}")
+            frame = frame.lstrip("/")
+        values[key] = frame
+
+    values["linear"] = _axis_limits(ns, params, "linear", "x", unknown)
+    values["angular"] = _axis_limits(ns, params, "angular", "z", unknown)
+
+    return DdcConfig(name=ns, left_wheels=left, right_wheels=right, unknown_keys=tuple(unknown),
+                     unsupported=tuple(unsupported), warnings=tuple(warnings), **values)
+
+
+class DdcStep(NamedTuple):
+    """What one ``DiffDriveControllerCore.update`` asks of the caller.
+
+    Attributes:
+        left: velocity command [rad/s] for every left wheel joint. right: the same for the right joints.
+        publish_odom: publish odom (and TF when enabled) now, stamped with this update's time.
+        skipped: a wheel position was not finite, so upstream's update returned early: odometry is frozen,
+            nothing is published (``cmd_vel_out`` included) and the wheels keep their previous commands,
+            which ``left``/``right`` repeat.
+    """
+
+    left: float
+    right: float
+    publish_odom: bool
+    skipped: bool = False
+
+
+class DiffDriveControllerCore:
+    """One DiffDriveController, minus ROS: commands and wheel positions in, wheel commands and odometry out.
+
+    Call ``starting(now)`` once (the controller manager does upstream), then ``update`` every control
+    cycle and ``set_command`` whenever a ``cmd_vel`` message arrives.
+
+    Args:
+        config: a ``DdcConfig``.
+        wheel_separation, wheel_radius: m, measured from the URDF by the caller; used only where the config
+            leaves the parameter unset (an explicit parameter wins, as upstream).
+
+    Raises:
+        ConfigError: separation or radius is neither in the config nor given (or is not > 0).
+    """
+
+    def __init__(self, config, wheel_separation=None, wheel_radius=None):
+        self.config = config
+        separation = config.wheel_separation if config.wheel_separation is not None else wheel_separation
+        radius = config.wheel_radius if config.wheel_radius is not None else wheel_radius
+        for key, value in (("wheel_separation", separation), ("wheel_radius", radius)):
+            if value is None or isinstance(value, bool) or not isinstance(value, (int, float)) \
+                    or not math.isfinite(value) or value <= 0:
+                raise ConfigError(f"{config.name}/{key}", value,
+                                  "a number > 0, in the parameter or measurable from the URDF")
+        # Effective geometry, multipliers applied once: both odometry and inverse kinematics use it, so a
+        # multiplier that is wrong for the real robot still gives self-consistent commands and odometry.
+        self.separation = config.wheel_separation_multiplier * separation
+        self.left_radius = config.left_wheel_radius_multiplier * radius
+        self.right_radius = config.right_wheel_radius_multiplier * radius
+        self.odometry = EncoderOdometry(self.left_radius, self.separation,
+                                        velocity_window=config.velocity_rolling_window_size,
+                                        right_wheel_radius=self.right_radius)
+        self.linear_limiter = config.linear.limiter()
+        self.angular_limiter = config.angular.limiter()
+        self.running = False
+        self._command = (0.0, 0.0, None)  # linear, angular, receipt time (None: never received)
+        self._last0 = (0.0, 0.0)  # the last limited command
+        self._last1 = (0.0, 0.0)  # the one before it (the jerk limiter needs both)
+        self._wheels = (0.0, 0.0)
+        self._last_publish_ns = None
+        period = config.publish_period
+        self._publish_period_ns = None if math.isinf(period) else _ns(period)
+        self._previous_time = None
+
+    # -- lifecycle ------------------------------------------------------------------------------------
+
+    def starting(self, now):
+        """Start at sim time ``now`` [s]: brake, restart the publish schedule and the odometry's dt."""
+        self.running = True
+        self.brake()
+        self._last_publish_ns = _ns(now)
+        self._previous_time = now
+        self.odometry.restart(now)
+
+    def stopping(self, now=None):
+        """Stop: brake and refuse commands until ``starting`` again. ``now`` is unused, as upstream."""
+        self.running = False
+        self.brake()
+
+    def brake(self):
+        """Zero both wheel commands (until the next ``update`` computes new ones)."""
+        self._wheels = (0.0, 0.0)
+
+    # -- input ----------------------------------------------------------------------------------------
+
+    def set_command(self, linear, angular, now, num_publishers=1):
+        """Take a ``cmd_vel`` (``linear.x`` [m/s], ``angular.z`` [rad/s]) received at sim time ``now``.
+
+        Args:
+            linear, angular: the Twist fields DDC reads. now: receipt time [s], what the timeout is measured
+                from. num_publishers: publishers on the subscriber's topic when the message arrived.
+
+        Returns:
+            None when accepted, otherwise the reason it was refused, for a throttled log. Refusals match
+            upstream: not running; more than one publisher while ``allow_multiple_cmd_vel_publishers`` is
+            false (brakes, but keeps the stored command, so an earlier one still runs until its timeout);
+            a NaN or infinite value.
+        """
+        if not self.running:
+            return "Can't accept new commands. Controller is not running."
+        if not self.config.allow_multiple_cmd_vel_publishers and num_publishers > 1:
+            self.brake()
+            return f"Detected {num_publishers} publishers. Only 1 publisher is allowed. Going to brake."
+        if not (math.isfinite(linear) and math.isfinite(angular)):
+            return "Received NaN in velocity command. Ignoring."
+        self._command = (float(linear), float(angular), now)
+        return None
+
+    # -- control cycle --------------------------------------------------------------------------------
+
+    def update(self, now, left_positions=None, right_positions=None, period=None):
+        """Run one control cycle at sim time ``now`` [s].
+
+        Order as upstream: odometry (closed loop from the mean of each side's joint angles, or open loop
+        from the last limited command); the publish decision; the command, zeroed when older than
+        ``cmd_vel_timeout``; the speed limiters (``period`` as dt); inverse kinematics.
+
+        Args:
+            now: sim time [s].
+            left_positions, right_positions: joint angles [rad], one per configured joint (a bare float is
+                taken as a one-element list); ignored with ``open_loop``.
+            period: the control period [s]; default: time since the previous ``update`` (or ``starting``).
+
+        Returns:
+            DdcStep.
+
+        Raises:
+            RuntimeError: called before ``starting``. ValueError: not one position per configured joint
+                (closed loop only).
+        """
+        if not self.running:
+            raise RuntimeError("DiffDriveControllerCore.update() before starting()")
+        if period is None:
+            period = now - self._previous_time
+        self._previous_time = now
+
+        # COMPUTE ODOMETRY
+        if self.config.open_loop:
+            self.odometry.update_open_loop(self._last0[0], self._last0[1], now)
+        else:
+            left = _mean(left_positions, len(self.config.left_wheels), "left_positions")
+            right = _mean(right_positions, len(self.config.right_wheels), "right_positions")
+            if not (math.isfinite(left) and math.isfinite(right)):
+                return DdcStep(self._wheels[0], self._wheels[1], False, True)
+            self.odometry.update(left, right, now)
+
+        # Fixed rate on upstream's integer-nanosecond clock (float sums of 0.02 would jitter by a cycle);
+        # the schedule advances by whole periods, so a late cycle does not shift later publications.
+        period_ns = self._publish_period_ns
+        publish = period_ns is not None and self._last_publish_ns + period_ns < _ns(now)
+        if publish:
+            self._last_publish_ns += period_ns
+
+        # MOVE ROBOT
+        linear, angular, stamp = self._command
+        if stamp is None or now - stamp > self.config.cmd_vel_timeout:
+            linear = angular = 0.0
+        linear = self.linear_limiter.limit(linear, self._last0[0], self._last1[0], period)
+        angular = self.angular_limiter.limit(angular, self._last0[1], self._last1[1], period)
+        self._last1, self._last0 = self._last0, (linear, angular)
+
+        rim_left, rim_right = wheel_speeds(linear, angular, self.separation)
+        self._wheels = (rim_left / self.left_radius, rim_right / self.right_radius)
+        return DdcStep(self._wheels[0], self._wheels[1], publish, False)
+
+    # -- state ----------------------------------------------------------------------------------------
+
+    @property
+    def pose(self):
+        """Odometry pose (x [m], y [m], yaw [rad]) in the odom frame; yaw is not wrapped, as upstream."""
+        return self.odometry.x, self.odometry.y, self.odometry.yaw
+
+    @property
+    def velocity(self):
+        """Odometry body velocity (linear [m/s], angular [rad/s]): rolling mean, or the command if open loop."""
+        return self.odometry.linear, self.odometry.angular
+
+    @property
+    def last_command(self):
+        """The last limited command (linear [m/s], angular [rad/s]): what ``cmd_vel_out`` carries."""
+        return self._last0
+
+    @property
+    def wheel_commands(self):
+        """The current (left, right) wheel command [rad/s]."""
+        return self._wheels
+
+    def joint_commands(self):
+        """Every wheel joint name mapped to its current velocity command [rad/s]."""
+        commands = {name: self._wheels[0] for name in self.config.left_wheels}
+        commands.update({name: self._wheels[1] for name in self.config.right_wheels})
+        return commands
+
+
+# -- helpers --------------------------------------------------------------------------------------------
+
+def _ns(seconds):
+    """Seconds as integer nanoseconds, rounded as ros::Time/ros::Duration do."""
+    return int(round(seconds * 1e9))
+
+
+def _mean(positions, count, label):
+    """Mean joint angle of one side; NaN/inf pass through so the caller can freeze odometry."""
+    if isinstance(positions, (int, float)) and not isinstance(positions, bool):
+        positions = (positions,)
+    if positions is None or len(positions) != count:
+        raise ValueError(f"{label}: expected {count} joint position(s), got {positions!r}")
+    return sum(positions) / count
+
+
+def _wheel_names(name, value):
+    expected = "a joint name or a non-empty list of joint names"
+    if isinstance(value, str):
+        if not value:
+            raise ConfigError(name, value, expected)
+        return (value,)
+    if isinstance(value, (list, tuple)) and value:
+        for index, item in enumerate(value):
+            if not isinstance(item, str) or not item:
+                raise ConfigError(f"{name}[{index}]", item, "a joint name (a non-empty string)")
+        return tuple(value)
+    raise ConfigError(name, value, expected)
+
+
+def _number(name, value, low=None, low_open=False, allow_inf=False):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ConfigError(name, value, "a number")
+    value = float(value)
+    if math.isnan(value) or (math.isinf(value) and not (allow_inf and value > 0)):
+        raise ConfigError(name, value, "a finite number")
+    if low is not None and (value < low or (low_open and value == low)):
+        raise ConfigError(name, value, f"a number {'>' if low_open else '>='} {low:g}")
+    return value
+
+
+def _bool(name, value):
+    if not isinstance(value, bool):
+        raise ConfigError(name, value, "true or false")
+    return value
+
+
+def _covariance(name, value):
+    if not isinstance(value, (list, tuple)) or len(value) != 6:
+        raise ConfigError(name, value, "a list of 6 numbers (the diagonal: x, y, z, roll, pitch, yaw)")
+    return tuple(_number(f"{name}[{index}]", item) for index, item in enumerate(value))
+
+
+def _axis_limits(ns, params, group, axis, unknown):
+    """Read ``<group>/<axis>/*`` (e.g. ``linear/x``); other axes and keys go to ``unknown``."""
+    prefix = f"{ns}/{group}"
+    block = params.get(group, {})
+    if not isinstance(block, dict):
+        raise ConfigError(prefix, block, f"a mapping such as {{{axis}: {{has_velocity_limits: true, ...}}}}")
+    unknown.extend(f"{prefix}/{key}" for key in block if key != axis)
+    limits = block.get(axis, {})
+    prefix = f"{prefix}/{axis}"
+    if not isinstance(limits, dict):
+        raise ConfigError(prefix, limits, "a mapping such as {has_velocity_limits: true, max_velocity: 1.0}")
+    known = set(_LIMIT_FLAGS)
+    values = {}
+    for flag in _LIMIT_FLAGS:
+        values[flag] = _bool(f"{prefix}/{flag}", limits[flag]) if flag in limits else False
+    for quantity, flag in _LIMIT_PAIRS:
+        high_key, low_key = f"max_{quantity}", f"min_{quantity}"
+        known.update((high_key, low_key))
+        high = _number(f"{prefix}/{high_key}", limits[high_key]) if high_key in limits else 0.0
+        low = _number(f"{prefix}/{low_key}", limits[low_key]) if low_key in limits else -high
+        if values[flag] and low > high:
+            # upstream would pin every command to max_*; almost surely a sign slip in the YAML
+            raise ConfigError(f"{prefix}/{low_key}", low, f"a number <= {prefix}/{high_key} ({high:g})")
+        values[high_key], values[low_key] = high, low
+    unknown.extend(f"{prefix}/{key}" for key in limits if key not in known)
+    return AxisLimits(**values)

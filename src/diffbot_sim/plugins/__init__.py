@@ -1,0 +1,10 @@
+"""Gazebo plugins, one module each, found by filename through :mod:`diffbot_sim.plugins.registry`.
+
+Like Gazebo, which loads a plugin class by its filename, gives it its SDF element and calls it on every
+world update: each module here owns its tags (both dialects where Gazebo had two), its defaults, its ROS
+endpoints and its per-step work. The simulator's loop asks every plugin of every robot what is due and
+knows none by name. ``tags`` (pure) reads the plugin elements of a model.
+"""
+from .tags import DIFF_DRIVE, JOINT_STATE, PluginBlock, Plugins, read_plugins
+
+__all__ = ["DIFF_DRIVE", "JOINT_STATE", "PluginBlock", "Plugins", "read_plugins"]

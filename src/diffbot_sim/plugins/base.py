@@ -1,0 +1,130 @@
+"""What every plugin gets (RobotContext) and what the loop asks of it (Plugin).
+
+The loop is single-threaded: subscriber callbacks (rospy's threads) only store data and wake the loop;
+``before_step``/``after_step`` run on the loop's thread, the only one that touches the physics.
+"""
+import math
+import warnings
+from dataclasses import dataclass
+from typing import Optional
+
+import rospy
+
+from ..config import prefix_frame
+
+
+def publisher(name, msg_class):
+    """A synchronous publisher: publish() writes on the loop's thread. Measured here, rospy's queued
+    publishers cost more CPU (a thread hand-off per message and connection) than the write itself; a
+    stalled subscriber is handled by the simulator's send timeout instead of by a queue."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SyntaxWarning)  # rospy warns on queue_size=None, which we mean
+        return rospy.Publisher(name, msg_class, queue_size=None)
+
+
+def join(namespace, name):
+    """Resolve ``name`` under a plugin namespace (None or "": the node's namespace, a relative name)."""
+    if name.startswith("/") or not namespace:
+        return name
+    return namespace.rstrip("/") + "/" + name.lstrip("/")
+
+
+def next_due(due, period, now):
+    """Next time after ``due`` (a multiple of ``period``); skips missed slots instead of bursting."""
+    if period <= 0:
+        return now
+    due += period
+    if due < now:
+        due = now + period
+    return due
+
+
+@dataclass
+class RobotContext:
+    """One robot as its plugins see it.
+
+    Attributes:
+        sim: the Simulator: ``warn(key, text)`` (throttled), ``wake`` (an Event a callback sets).
+        cfg: the SimConfig. spec: the RobotSpec. model: the RobotModel. robot: the physics Robot.
+        params: the node's private parameters (a dict, read once).
+        namespace: ``/<name>`` for a named robot of ``~robots`` (it replaces every plugin's own), else None.
+        private: prefix of this robot's private topics (``~`` or ``~<name>/``).
+    """
+
+    sim: object
+    cfg: object
+    spec: object
+    model: object
+    robot: object
+    params: dict
+    namespace: Optional[str]
+    private: str
+
+    @property
+    def tf_prefix(self):
+        if not self.spec.name:
+            return ""
+        return self.spec.name if self.spec.tf_prefix is None else self.spec.tf_prefix
+
+    def frame(self, name):
+        """A frame id as published: a leading slash stripped (tf2 rejects it), the robot's tf_prefix."""
+        return prefix_frame(self.tf_prefix, name)
+
+    def clean_frame(self, name, where):
+        """A frame id from a tag, without the leading slash tf2 rejects (with a warning naming ``where``);
+        not yet prefixed (``frame`` does that)."""
+        if name.startswith("/"):
+            self.warnings.append(f"{where}: frame '{name}' has a leading slash, which tf2 rejects; "
+                                 f"using '{name.lstrip('/')}'")
+            return name.lstrip("/")
+        return name
+
+    def plugin_namespace(self, tag_value, default=None):
+        """The namespace a plugin's topics live in: the robot's (``~robots``) replaces the plugin's own
+        ``robotNamespace``, as gazebo_ros's spawner does; else the tag; else ``default``."""
+        if self.namespace:
+            return self.namespace
+        return tag_value if tag_value is not None else default
+
+    def __post_init__(self):
+        self.warnings = []  # start-up warnings of this robot's plugins, logged once in the report
+
+
+class Plugin:
+    """What the loop calls. Times are sim seconds; ``stamp`` is the same time as a rospy.Time."""
+
+    #: The plugin's filename (or a descriptive name for built-in ones), for reports.
+    filename = ""
+
+    def joints(self):
+        """Joints this plugin commands (a joint has one owner)."""
+        return set()
+
+    def publishers(self):
+        """Publishers the loop writes to (their connections are tuned and batched by the simulator)."""
+        return []
+
+    def next_due(self):
+        """Sim time at which ``before_step`` has work (control); inf: only when a command arrives."""
+        return math.inf
+
+    def next_publish(self):
+        """Sim time at which ``after_step`` has work (publishing)."""
+        return math.inf
+
+    def before_step(self, now):
+        """Apply new commands and run control that is due (called before each physics step, and at once
+        when a callback wakes the loop in real time)."""
+
+    def after_step(self, now, stamp, transforms):
+        """Publish what is due; TF transforms go into ``transforms`` (one TFMessage per step)."""
+
+    def start(self, now):
+        """The loop starts at sim time ``now`` (also after a reset)."""
+
+    def reset(self, now):
+        """Brake and forget pending commands (reset_simulation)."""
+
+    def summary(self):
+        """Effective settings for the start-up report: {name: value}."""
+        return {}

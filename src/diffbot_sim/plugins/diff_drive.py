@@ -1,0 +1,163 @@
+"""``libgazebo_ros_diff_drive.so`` (ROS 1 and ROS 2 tags) and, with other tags and defaults,
+``libgazebo_ros_skid_steer_drive.so`` (see :mod:`diffbot_sim.plugins.skid_steer`).
+
+Tags, defaults and validation: :class:`diffbot_sim.config.DriveConfig` (one place). Kinematics, limits
+and encoder odometry: the shared pure units (controller, kinematics, limits, odometry).
+
+Topics (relative to the plugin's namespace): ``cmd_vel`` in (Twist: linear.x, angular.z), ``odom`` out,
+``/tf`` odometry frame -> base frame when publish_odom_tf; ``~debug/cmd_applied`` when asked.
+"""
+import threading
+import time
+
+import rospy
+from geometry_msgs.msg import Twist, TwistStamped
+from nav_msgs.msg import Odometry
+
+from .. import config as cfgmod
+from .. import ros_msgs
+from ..controller import DiffDriveController, non_finite_field
+from ..kinematics import quaternion_from_yaw
+from ..odometry import EncoderOdometry
+from .base import Plugin, join, next_due, publisher
+
+
+class DiffDrive(Plugin):
+    """One differential (or skid-steer) drive: cmd_vel -> wheel velocity motors; odometry out."""
+
+    filename = "libgazebo_ros_diff_drive.so"
+
+    def __init__(self, ctx, drive):
+        """``drive``: a validated DriveConfig (frames already prefixed and namespace placed)."""
+        self.ctx = ctx
+        self.drive = drive
+        cfg, robot = ctx.cfg, ctx.robot
+        self.max_wheel_velocity = cfgmod.max_wheel_velocity(cfg, ctx.model, drive)
+        self.controller = DiffDriveController(drive.wheel_separation, drive.wheel_radius, self.max_wheel_velocity,
+                                              drive.max_wheel_acceleration, cfg.cmd_vel_timeout)
+        self.left_idx = robot.indices(drive.left_joints)
+        self.right_idx = robot.indices(drive.right_joints)
+        self.wheel_idx = self.left_idx + self.right_idx
+        self.wheel_forces = cfgmod.wheel_efforts(ctx.model, drive)
+        self.update_period = 1.0 / drive.update_rate if drive.update_rate > 0 else 0.0
+        self.next_update = 0.0
+        self.last_update = 0.0
+        self.next_odom = 0.0
+        self.encoder = EncoderOdometry(drive.wheel_radius, drive.wheel_separation)
+        self._lock = threading.Lock()
+        self._pending = None
+        ns = drive.namespace
+        self.cmd_sub = rospy.Subscriber(join(ns, drive.command_topic), Twist, self._on_twist, queue_size=1)
+        self.odom_pub = publisher(join(ns, drive.odometry_topic), Odometry) if drive.publish_odom else None
+        self.odom_builder = ros_msgs.OdometryBuilder(drive.odometry_frame, drive.robot_base_frame,
+                                                     drive.covariance_x, drive.covariance_y, drive.covariance_yaw)
+        self.tf_builder = ros_msgs.TransformBuilder(drive.odometry_frame, drive.robot_base_frame)
+        self.debug_pub = (publisher(ctx.private + "debug/cmd_applied", TwistStamped)
+                          if cfg.debug_cmd_applied else None)
+
+    # -- callbacks (rospy's threads) ----------------------------------------------------------------
+    def _on_twist(self, msg):
+        """Keep the newest *valid* command and wake the loop, which applies it (at once in real time, at the
+        next step in fast mode). Validating here means a good command followed by a NaN one keeps the good
+        one, as diff_drive_controller does."""
+        values = ros_msgs.twist_values(msg)
+        bad = non_finite_field(values)
+        if bad is not None:
+            self.ctx.sim.warn(f"nonfinite:{id(self)}", f"ignored a cmd_vel with a non-finite {bad} {values}; "
+                              "the robot keeps its last valid command")
+            return
+        with self._lock:
+            self._pending = values
+        self.ctx.sim.wake.set()
+
+    def _take(self):
+        if self._pending is None:
+            return None
+        with self._lock:
+            twist, self._pending = self._pending, None
+        return twist
+
+    # -- loop ---------------------------------------------------------------------------------------
+    def joints(self):
+        return set(self.drive.left_joints + self.drive.right_joints)
+
+    def publishers(self):
+        return [p for p in (self.odom_pub, self.debug_pub) if p is not None]
+
+    def next_due(self):
+        return self.next_update
+
+    def next_publish(self):
+        return self.next_odom
+
+    def before_step(self, now):
+        twist = self._take()
+        fresh = False
+        if twist is not None:
+            fresh = self.controller.set_command(twist[0], twist[5], now)
+        elif now + 1e-9 < self.next_update:
+            expiry = self.controller.expiry()
+            if expiry is None or now < expiry:
+                return  # nothing new, nothing due: the motors keep their targets
+        robot = self.ctx.robot
+        _, velocities, _ = robot.joint_states(self.wheel_idx)
+        n = len(self.left_idx)
+        left_v = sum(velocities[:n]) / n
+        right_v = sum(velocities[n:]) / n
+        dt = max(now - self.last_update, self.ctx.cfg.time_step)
+        left, right = self.controller.update(now, left_v, right_v, dt)
+        robot.set_velocities(self.wheel_idx, [left] * n + [right] * n, self.wheel_forces)
+        self.last_update = now
+        if now + 1e-9 >= self.next_update:
+            self.next_update = next_due(self.next_update, self.update_period, now)
+        if fresh and self.debug_pub is not None:
+            self.debug_pub.publish(ros_msgs.twist_stamped(rospy.Time.from_sec(time.time()), twist[0], twist[5]))
+
+    def after_step(self, now, stamp, transforms):
+        if now + 1e-9 < self.next_odom:
+            return
+        self.next_odom = next_due(self.next_odom, self.update_period, now)
+        drive, robot = self.drive, self.ctx.robot
+        if drive.odometry_source == "encoder":
+            positions, _, _ = robot.joint_states([self.left_idx[0], self.right_idx[0]])
+            self.encoder.update(positions[0], positions[1], now)
+            enc = self.encoder
+            position = (enc.x, enc.y, 0.0)
+            orientation = quaternion_from_yaw(enc.yaw)
+            linear, angular = (enc.linear, 0.0, 0.0), (0.0, 0.0, enc.angular)
+        else:
+            position, orientation = robot.base_pose()
+            linear, angular = robot.base_twist((position, orientation))
+        if self.odom_pub is not None and self.odom_pub.get_num_connections():
+            self.odom_pub.publish(self.odom_builder.build(stamp, position, orientation, linear, angular))
+        if drive.publish_odom_tf:
+            transforms.append(self.tf_builder.build(stamp, position, orientation))
+
+    def start(self, now):
+        positions, _, _ = self.ctx.robot.joint_states([self.left_idx[0], self.right_idx[0]])
+        self.encoder.reset(positions[0], positions[1], now)
+
+    def reset(self, now):
+        self.controller.brake()
+        self.ctx.robot.set_velocities(self.wheel_idx, [0.0] * len(self.wheel_idx), self.wheel_forces)
+        with self._lock:
+            self._pending = None
+
+    def summary(self):
+        params = cfgmod.as_params(self.drive)
+        params["wheel_radius"] = self.drive.wheel_radius
+        params["effective_max_wheel_velocity"] = self.max_wheel_velocity
+        return params
+
+
+def create(ctx, block, params):
+    """The model's diff drive (``block`` may be None when ``~left_joints`` describes one), or None."""
+    drive = cfgmod.drive_config(ctx.model, block, params)
+    if drive is None:
+        return None
+    where = block.path if block is not None else "private parameters"
+    drive.odometry_frame = ctx.clean_frame(drive.odometry_frame, where)
+    drive.robot_base_frame = ctx.clean_frame(drive.robot_base_frame, where)
+    if ctx.namespace:
+        cfgmod.place_in_namespace(ctx.spec, drive, None)
+    return DiffDrive(ctx, drive)

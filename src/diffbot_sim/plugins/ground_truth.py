@@ -1,0 +1,33 @@
+"""``~ground_truth`` (nav_msgs/Odometry in ``world``): the physics pose and twist of the robot's base, as
+Gazebo's p3d plugin gives them; for judging odometry. Enabled by ``~publish_ground_truth``."""
+from nav_msgs.msg import Odometry
+
+from .. import ros_msgs
+from .base import Plugin, next_due, publisher
+
+
+class GroundTruth(Plugin):
+    filename = "(simulator) ~ground_truth"
+
+    def __init__(self, ctx, child_frame, rate=100.0):
+        self.ctx = ctx
+        self.pub = publisher(ctx.private + "ground_truth", Odometry)
+        self.builder = ros_msgs.OdometryBuilder("world", child_frame, 0.0, 0.0, 0.0)
+        self.period = 1.0 / rate
+        self.next = 0.0
+
+    def publishers(self):
+        return [self.pub]
+
+    def next_publish(self):
+        return self.next
+
+    def after_step(self, now, stamp, transforms):
+        if now + 1e-9 < self.next:
+            return
+        self.next = next_due(self.next, self.period, now)
+        if self.pub.get_num_connections():
+            robot = self.ctx.robot
+            pose = robot.base_pose()
+            linear, angular = robot.base_twist(pose)
+            self.pub.publish(self.builder.build(stamp, pose[0], pose[1], linear, angular))

@@ -1,0 +1,50 @@
+"""``libgazebo_ros_joint_state_publisher.so``: ``joint_states`` (name, position, velocity, effort) at
+``updateRate``; also the drive's wheels when the drive says ``publishWheelJointState``.
+
+Tags and defaults: :class:`diffbot_sim.config.JointStateConfig`.
+"""
+from sensor_msgs.msg import JointState
+
+from .. import config as cfgmod
+from .. import ros_msgs
+from .base import Plugin, join, next_due, publisher
+
+
+class JointStatePublisher(Plugin):
+    filename = "libgazebo_ros_joint_state_publisher.so"
+
+    def __init__(self, ctx, cfg, topic=None):
+        self.ctx = ctx
+        self.cfg = cfg
+        self.indices = ctx.robot.indices(cfg.joints)
+        self.pub = publisher(topic or join(cfg.namespace, cfg.topic), JointState)
+        self.builder = ros_msgs.JointStateBuilder(list(cfg.joints))
+        self.period = 1.0 / cfg.update_rate if cfg.update_rate > 0 else 0.0
+        self.next = 0.0
+
+    def publishers(self):
+        return [self.pub]
+
+    def next_publish(self):
+        return self.next
+
+    def after_step(self, now, stamp, transforms):
+        if now + 1e-9 < self.next:
+            return
+        self.next = next_due(self.next, self.period, now)
+        if self.pub.get_num_connections():  # nobody listening: skip the read-out and the message
+            positions, velocities, efforts = self.ctx.robot.joint_states(self.indices)
+            self.pub.publish(self.builder.build(stamp, positions, velocities, efforts))
+
+    def summary(self):
+        return {"joint_states": ",".join(self.cfg.joints)}
+
+
+def create(ctx, block, drive):
+    """From the plugin block (may be None) and the drive (its publishWheelJointState); None if no joints."""
+    cfg = cfgmod.joint_state_config(ctx.model, block, drive)
+    if cfg is None:
+        return None
+    if ctx.namespace:
+        cfg.namespace = ctx.namespace
+    return JointStatePublisher(ctx, cfg)

@@ -1,0 +1,200 @@
+"""``libgazebo_ros_kobuki.so``: the TurtleBot 2 (Kobuki) base, as kobuki_gazebo_plugins (melodic) runs it.
+
+Tags (snake_case): ``left_wheel_joint_name``, ``right_wheel_joint_name``, ``wheel_separation``,
+``wheel_diameter``, ``torque``, ``velocity_command_timeout`` (all required by the original, which refuses to
+load without them), ``publish_tf`` (default false), ``imu_name``, ``update_rate`` (default 50 Hz);
+``cliff_sensor_*``, ``bumper_name``, ``base_collision_model_link`` are accepted.
+
+Topics, in the plugin's namespace (``robotNamespace``; the spawner's ``/`` by default), ``base_prefix`` being
+the ROS parameter ``<ns>/base_prefix`` (a ``<base_prefix>`` tag also accepted; default ``mobile_base``):
+``<base_prefix>/commands/velocity`` (Twist in), ``<base_prefix>/commands/reset_odometry`` (std_msgs/Empty
+in), ``odom`` (frames ``odom`` -> ``base_footprint``, fixed as in the original; TF when ``publish_tf``),
+``joint_states`` (both wheels), ``<base_prefix>/sensors/imu_data`` (sensor_msgs/Imu of the base).
+Odometry integrates wheel speed x radius for distance and the IMU's yaw rate for heading, as the original
+does. ``commands/motor_power`` and ``events/cliff|bumper`` need kobuki_msgs, which Debian does not ship:
+named once in a warning.
+"""
+import math
+import threading
+
+import rospy
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import Imu, JointState
+from std_msgs.msg import Empty
+
+from .. import ros_msgs
+from ..config import _bool, _number, _string
+from ..controller import non_finite_field
+from ..errors import ModelError
+from ..kinematics import quaternion_from_yaw, wheel_speeds
+from ..model import tag_value
+from .base import Plugin, join, next_due, publisher
+from .joint_motors import UNLIMITED_EFFORT
+
+REQUIRED = ("left_wheel_joint_name", "right_wheel_joint_name", "wheel_separation", "wheel_diameter",
+            "torque", "velocity_command_timeout")
+ACCEPTED = ("cliff_sensor_left_name", "cliff_sensor_center_name", "cliff_sensor_front_name",
+            "cliff_sensor_right_name", "cliff_detection_threshold", "bumper_name", "base_collision_model_link",
+            "robotNamespace", "publish_tf", "imu_name", "update_rate", "base_prefix", "alwaysOn")
+#: The original's fixed odometry covariances (pose x, y, yaw; unobserved axes 1e6).
+POSE_COVARIANCE = (0.1, 0.1, 1e6, 1e6, 1e6, 0.05)
+
+
+class Kobuki(Plugin):
+    filename = "libgazebo_ros_kobuki.so"
+
+    def __init__(self, ctx, values, path, base_prefix, ns):
+        self.ctx = ctx
+        self.values = values
+        model, robot = ctx.model, ctx.robot
+        self.joints_ = [values["left_wheel_joint_name"], values["right_wheel_joint_name"]]
+        for name in self.joints_:
+            model.joint(name, path)
+        self.idx = robot.indices(self.joints_)
+        self.radius = values["wheel_diameter"] / 2.0
+        self.separation = values["wheel_separation"]
+        self.torque = values["torque"] if values["torque"] > 0 else UNLIMITED_EFFORT
+        self.timeout = values["velocity_command_timeout"]
+        self.period = 1.0 / values["update_rate"] if values["update_rate"] > 0 else 0.0
+        self.publish_tf = values["publish_tf"]
+        self.odom_frame, self.base_frame = ctx.frame("odom"), ctx.frame("base_footprint")
+        self.wheel_cmd = (0.0, 0.0)
+        self.cmd_time = None
+        self.x = self.y = self.yaw = 0.0
+        self.last_time = None
+        self.next = 0.0
+        self._lock = threading.Lock()
+        self._pending = None
+        self._reset_odom = False
+        prefix = base_prefix.strip("/")
+        self.cmd_sub = rospy.Subscriber(join(ns, f"{prefix}/commands/velocity"), Twist, self._on_twist,
+                                        queue_size=1)
+        self.reset_sub = rospy.Subscriber(join(ns, f"{prefix}/commands/reset_odometry"), Empty,
+                                          self._on_reset, queue_size=1)
+        self.odom_pub = publisher(join(ns, "odom"), Odometry)
+        self.js_pub = publisher(join(ns, "joint_states"), JointState)
+        self.imu_pub = publisher(join(ns, f"{prefix}/sensors/imu_data"), Imu)
+        self.odom_builder = ros_msgs.OdometryBuilder(self.odom_frame, self.base_frame, 0, 0, 0,
+                                                     pose_diagonal=POSE_COVARIANCE,
+                                                     twist_diagonal=(0.0,) * 6)
+        self.tf_builder = ros_msgs.TransformBuilder(self.odom_frame, self.base_frame)
+        self.js_builder = ros_msgs.JointStateBuilder(self.joints_)
+        self.imu_frame = ctx.frame("base_link")
+        self.topics = {"cmd_vel": self.cmd_sub.resolved_name, "odom": self.odom_pub.resolved_name}
+        ctx.warnings.append(f"{path}: {join(ns, prefix)}/commands/motor_power and events/cliff, events/bumper "
+                            "are not simulated (their kobuki_msgs types are not in Debian)")
+
+    # -- callbacks ----------------------------------------------------------------------------------
+    def _on_twist(self, msg):
+        values = ros_msgs.twist_values(msg)
+        bad = non_finite_field(values)
+        if bad is not None:
+            self.ctx.sim.warn(f"nonfinite:{id(self)}", f"ignored a velocity command with a non-finite {bad}")
+            return
+        with self._lock:
+            self._pending = (values[0], values[5])
+        self.ctx.sim.wake.set()
+
+    def _on_reset(self, _msg):
+        self._reset_odom = True
+
+    # -- loop ---------------------------------------------------------------------------------------
+    def joints(self):
+        return set(self.joints_)
+
+    def publishers(self):
+        return [self.odom_pub, self.js_pub, self.imu_pub]
+
+    def next_due(self):
+        if self.cmd_time is not None and self.wheel_cmd != (0.0, 0.0):
+            return self.cmd_time + self.timeout
+        return math.inf
+
+    def next_publish(self):
+        return self.next
+
+    def before_step(self, now):
+        if self._pending is not None:
+            with self._lock:
+                (linear, angular), self._pending = self._pending, None
+            self.wheel_cmd = wheel_speeds(linear, angular, self.separation)
+            self.cmd_time = now
+        elif self.cmd_time is None or now - self.cmd_time <= self.timeout:
+            return
+        else:
+            self.wheel_cmd, self.cmd_time = (0.0, 0.0), None  # stale: stop, as the original does
+        left, right = self.wheel_cmd
+        self.ctx.robot.set_velocities(self.idx, [left / self.radius, right / self.radius], [self.torque] * 2)
+
+    def after_step(self, now, stamp, transforms):
+        if now + 1e-9 < self.next:
+            return
+        self.next = next_due(self.next, self.period, now)
+        robot = self.ctx.robot
+        positions, velocities, efforts = robot.joint_states(self.idx)
+        pose = robot.base_pose()
+        linear, angular = robot.base_twist(pose)
+        dt = 0.0 if self.last_time is None else now - self.last_time
+        self.last_time = now
+        if self._reset_odom:
+            self._reset_odom = False
+            self.x = self.y = self.yaw = 0.0
+        distance = dt * self.radius * (velocities[0] + velocities[1]) / 2.0
+        yaw_rate = angular[2]  # the IMU's rate about its z (the base's; the IMU sits on the rigid base)
+        self.x += distance * math.cos(self.yaw)
+        self.y += distance * math.sin(self.yaw)
+        self.yaw += yaw_rate * dt
+        orientation = quaternion_from_yaw(self.yaw)
+        speed = distance / dt if dt > 0 else 0.0
+        if self.odom_pub.get_num_connections():
+            self.odom_pub.publish(self.odom_builder.build(stamp, (self.x, self.y, 0.0), orientation,
+                                                          (speed, 0.0, 0.0), (0.0, 0.0, yaw_rate)))
+        if self.publish_tf:
+            transforms.append(self.tf_builder.build(stamp, (self.x, self.y, 0.0), orientation))
+        if self.js_pub.get_num_connections():
+            self.js_pub.publish(self.js_builder.build(stamp, positions, velocities, efforts))
+        if self.imu_pub.get_num_connections():
+            self.imu_pub.publish(ros_msgs.imu(stamp, self.imu_frame, pose[1], angular,
+                                              robot.base_acceleration(pose, dt)))
+
+    def start(self, now):
+        self.last_time = now
+        self.x = self.y = self.yaw = 0.0
+
+    def reset(self, now):
+        with self._lock:
+            self._pending = None
+        self.wheel_cmd, self.cmd_time = (0.0, 0.0), None
+        self.ctx.robot.set_velocities(self.idx, [0.0, 0.0], [self.torque] * 2)
+        self.start(now)
+
+    def summary(self):
+        return dict(self.values, **self.topics)
+
+
+def create(ctx, element, path, params):
+    tags = {child.tag: tag_value(child) for child in element}
+    missing = [t for t in REQUIRED if t not in tags]
+    if missing:
+        raise ModelError(f"the Kobuki plugin needs <{missing[0]}> (it refuses to load without it)",
+                         ctx.model.source, path)
+    values = {
+        "left_wheel_joint_name": _string(f"<left_wheel_joint_name> of {path}", tags["left_wheel_joint_name"]),
+        "right_wheel_joint_name": _string(f"<right_wheel_joint_name> of {path}", tags["right_wheel_joint_name"]),
+        "wheel_separation": _number(f"<wheel_separation> of {path}", tags["wheel_separation"], low=0.0,
+                                    low_open=True),
+        "wheel_diameter": _number(f"<wheel_diameter> of {path}", tags["wheel_diameter"], low=0.0, low_open=True),
+        "torque": _number(f"<torque> of {path}", tags["torque"], low=0.0),
+        "velocity_command_timeout": _number(f"<velocity_command_timeout> of {path}",
+                                            tags["velocity_command_timeout"], low=0.0),
+        "publish_tf": _bool(f"<publish_tf> of {path}", tags.get("publish_tf", "false")),
+        "update_rate": _number(f"<update_rate> of {path}", tags.get("update_rate", 50.0), low=0.0),
+    }
+    unknown = sorted(set(tags) - set(REQUIRED) - set(ACCEPTED))
+    if unknown:
+        ctx.warnings.append(f"{path}: unknown tags ignored: {', '.join(unknown)}")
+    ns = ctx.plugin_namespace(tags.get("robotNamespace"), "/")
+    # The original reads base_prefix as a ROS parameter of its node handle (<ns>/base_prefix).
+    base_prefix = tags.get("base_prefix") or rospy.get_param(join(ns, "base_prefix"), "mobile_base")
+    return Kobuki(ctx, values, path, str(base_prefix), ns)

@@ -1,0 +1,49 @@
+"""Plugin filename -> the module that simulates it (one line per plugin), and building a robot's plugins.
+
+The two plugins the model reader parses itself (diff drive, joint-state publisher) are built from their
+PluginBlocks; every other one from its element by its module's ``create(ctx, element, path, params)``.
+"""
+from . import diff_drive, joint_state, kobuki, planar_move, ros_control, skid_steer
+from .ground_truth import GroundTruth
+from .joint_motors import JointMotors
+from .tags import DIFF_DRIVE, JOINT_STATE
+
+#: Model plugins by filename (``libNAME.so``).
+MODEL_PLUGINS = {
+    "libgazebo_ros_skid_steer_drive.so": skid_steer.create,
+    "libgazebo_ros_planar_move.so": planar_move.create,
+    "libgazebo_ros_kobuki.so": kobuki.create,
+    "libgazebo_ros_control.so": ros_control.create,
+}
+#: Every filename simulated (the rest are named once as not simulated).
+KNOWN = (DIFF_DRIVE, JOINT_STATE) + tuple(MODEL_PLUGINS)
+
+
+def build(ctx, found, params):
+    """Every plugin of one robot, in model order, plus the transmission motors no plugin owns and the
+    optional ground truth. ``found`` is the model's :class:`~diffbot_sim.plugins.tags.Plugins`.
+
+    Raises:
+        DiffbotSimError: a plugin whose tags or parameters cannot be used (naming them).
+    """
+    plugins = []
+    drive = diff_drive.create(ctx, found.diff_drive, params)
+    if drive is not None:
+        plugins.append(drive)
+    for item in found.others:
+        factory = MODEL_PLUGINS.get(item.filename)
+        if factory is not None:
+            plugins.append(factory(ctx, item.element, item.path, params))
+    js = joint_state.create(ctx, found.joint_state, drive.drive if drive is not None else None)
+    if js is not None:
+        plugins.append(js)
+    owned = set()
+    for plugin in plugins:
+        owned |= plugin.joints()
+    rest = [t for t in ctx.model.transmissions if t.joint not in owned]
+    if rest:
+        plugins.append(JointMotors(ctx, rest))
+    if ctx.cfg.publish_ground_truth:
+        base = next((p.drive.robot_base_frame for p in plugins if hasattr(p, "drive")), ctx.frame(ctx.model.root))
+        plugins.append(GroundTruth(ctx, base))
+    return plugins

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Runs `make test` (and checks that `make run` brings up /odom) as a new user would: in a fresh
+# `debootstrap --variant=minbase bookworm` chroot, a clean clone of this checkout's HEAD, entered with
+# `env -i`. Needs root and the network to Debian's mirror and PyPI. ~20 min, most of it installing.
+#   sudo bash tools/clean_machine_test.sh [CHROOT_DIR]     (the directory is deleted afterwards)
+set -eo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+DIR="${1:-/var/tmp/diffbot_clean_machine}"
+log() { printf '[clean-machine] %s\n' "$*"; }
+
+command -v debootstrap >/dev/null || { apt-get update -q && apt-get install -y -q debootstrap; }
+cleanup() {
+  for m in run/netns dev/pts dev proc sys; do
+    mountpoint -q "$DIR/$m" 2>/dev/null && umount -l "$DIR/$m" || true
+  done
+  rm -rf "$DIR"
+}
+trap cleanup EXIT
+cleanup
+log "debootstrap minbase bookworm into $DIR"
+debootstrap --variant=minbase bookworm "$DIR" http://deb.debian.org/debian >"$DIR.debootstrap.log" 2>&1 \
+  || { tail -20 "$DIR.debootstrap.log"; exit 1; }
+cp /etc/resolv.conf "$DIR/etc/resolv.conf"
+mount -t proc proc "$DIR/proc"; mount -t sysfs sys "$DIR/sys"
+mount --bind /dev "$DIR/dev"; mount --bind /dev/pts "$DIR/dev/pts"
+log "minimal tools a user has before cloning (git, make, sudo-less root)"
+chroot "$DIR" /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin DEBIAN_FRONTEND=noninteractive \
+  bash -c 'apt-get update -q >/dev/null && apt-get install -y -q --no-install-recommends git make ca-certificates >/dev/null'
+git clone -q "$ROOT" "$DIR/root/project"
+log "make test in the chroot (env -i)"
+set +e
+env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin TERM=xterm LANG=C.UTF-8 \
+  chroot "$DIR" /bin/bash -lc 'cd /root/project && make test' 2>&1 | tee "$DIR.make_test.log" | grep -E '^\[|passed|failed'
+status=${PIPESTATUS[0]}
+log "make test exited $status"
+log "make run (no terminal: simulator alone) until /odom appears"
+env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin TERM=xterm LANG=C.UTF-8 \
+  chroot "$DIR" /bin/bash -lc 'cd /root/project && (make run </dev/null >/tmp/run.log 2>&1 &) ;
+    source catkin_ws/devel/setup.bash; for i in $(seq 1 150); do rostopic list 2>/dev/null | grep -qx /odom && break; sleep 0.2; done;
+    if rostopic echo -n 1 /odom/header/frame_id; then echo "make run: /odom is up"; r=0; else echo "make run: no /odom"; tail /tmp/run.log; r=1; fi;
+    pkill -INT -f roslaunch; sleep 2; pkill -KILL -f "ros|bullet_sim" ; exit $r'
+run_status=$?
+set -e
+[ "$status" -eq 0 ] && [ "$run_status" -eq 0 ]
