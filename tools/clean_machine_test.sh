@@ -21,6 +21,12 @@ log "debootstrap minbase bookworm into $DIR"
 debootstrap --variant=minbase bookworm "$DIR" http://deb.debian.org/debian >"$DIR.debootstrap.log" 2>&1 \
   || { tail -20 "$DIR.debootstrap.log"; exit 1; }
 cp /etc/resolv.conf "$DIR/etc/resolv.conf"
+# This sandbox reaches PyPI through a TLS-intercepting proxy whose CA only the host trusts (its pip.conf
+# names the bundle). Hand the chroot the same trust, and nothing else of the host's configuration.
+if [ -f /etc/ssl/certs/ca-certificates.crt ]; then
+  mkdir -p "$DIR/etc/ssl/certs" && cp /etc/ssl/certs/ca-certificates.crt "$DIR/etc/ssl/host-ca.crt"
+  printf '[global]\ncert = /etc/ssl/host-ca.crt\n' > "$DIR/etc/pip.conf"
+fi
 mount -t proc proc "$DIR/proc"; mount -t sysfs sys "$DIR/sys"
 mount --bind /dev "$DIR/dev"; mount --bind /dev/pts "$DIR/dev/pts"
 log "minimal tools a user has before cloning (git, make, sudo-less root)"

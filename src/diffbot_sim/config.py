@@ -348,6 +348,17 @@ def as_params(cfg):
 
 # -------------------------------------------------------------------------------------------- validators
 
+#: Warnings of values Gazebo tolerates (taken and cleared by the caller that logs them: ``take_notes``).
+NOTES = []
+
+
+def take_notes():
+    """The tolerated-value warnings gathered since the last call."""
+    notes = list(NOTES)
+    NOTES.clear()
+    return notes
+
+
 def _drive_value(key, value, label):
     if key in ("left_joints", "right_joints"):
         names = [value] if isinstance(value, str) else value
@@ -366,10 +377,14 @@ def _drive_value(key, value, label):
     if key in ("publish_odom", "publish_odom_tf", "publish_wheel_joint_state"):
         return _bool(label, value)
     if key == "odometry_source":
-        text = str(value).strip().lower()
+        text = str(value).strip()
         mapped = {"0": "encoder", "1": "world", "encoder": "encoder", "world": "world"}.get(text)
         if mapped is None:
-            raise ConfigError(label, value, "world or encoder (ROS 2: 1 or 0)")
+            # gazebo_ros_diff_drive compares with "encoder" and "world" exactly; anything else (a published
+            # model writes ENCODER) gets a warning and the world pose.
+            NOTES.append(f"{label}: '{value}' is neither 'encoder' nor 'world' (Gazebo matches them exactly); "
+                         "using world, as Gazebo does")
+            return "world"
         return mapped
     if key == "namespace":
         return _string(label, value, allow_empty=True)

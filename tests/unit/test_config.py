@@ -189,7 +189,6 @@ def test_as_params_drops_none(parse, make_urdf):
     ("<max_wheel_torque>nan</max_wheel_torque>", "max_wheel_torque", "nan"),
     ("<max_wheel_acceleration>inf</max_wheel_acceleration>", "max_wheel_acceleration", "inf"),
     ("<publish_odom>maybe</publish_odom>", "publish_odom", "maybe"),
-    ("<odometry_source>2</odometry_source>", "odometry_source", "2"),
     ("<update_rate>-5</update_rate>", "update_rate", "-5"),
 ])
 def test_bad_ros2_tag_values(parse, make_urdf, body, tag, value):
@@ -347,3 +346,15 @@ def test_wheel_efforts_capped_by_urdf_limit():
     model.joints["right_wheel_joint"].effort_limit = 7.0
     model.joints["left_wheel_joint"].effort_limit = None
     assert config.wheel_efforts(model, drive) == [30.0, 7.0]
+
+
+@pytest.mark.parametrize("text", ["ENCODER", "2", "ground_truth"])
+def test_unmatched_odometry_source_warns_and_uses_world(parse, make_urdf, text):
+    """gazebo_ros_diff_drive matches 'encoder' and 'world' exactly; anything else warns and uses world."""
+    from diffbot_sim.config import take_notes
+
+    take_notes()
+    cfg = _drive(parse, make_urdf, _ros1(f"<odometrySource>{text}</odometrySource>"))
+    assert cfg.odometry_source == "world"
+    notes = take_notes()
+    assert len(notes) == 1 and "<odometrySource>" in notes[0] and text in notes[0]

@@ -1,0 +1,124 @@
+#!/usr/bin/env python3
+"""A fixture robot loaded unchanged drives as in Gazebo: straight at 0.2 m/s for 4 s (0.8 m, heading kept)
+and in place at 0.5 rad/s for 4 s, judged on its own odometry topic and on the physics ground truth.
+
+Private parameters: ~cmd_topic, ~odom_topic (the robot's own), ~urdf_mass (kg, the URDF's sum, computed by
+hand in the fixture's comment), ~skid (bool, default false): a four-wheel robot driven as a diff drive
+turns its body slower than its wheels say (its wheels slide sideways; real YAMLs carry a
+wheel_separation_multiplier for it), so in the turn its ground truth need only turn the right way by a
+quarter of the command and stay within 0.2 m, while its own odometry must still read the commanded turn. Callbacks only record; waits poll with deadlines; times are sim time.
+"""
+import math
+import sys
+import threading
+import time
+import unittest
+
+import rospy
+import rostest
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+
+SIM = "/bullet_sim"
+SPEED, TURN, SECONDS = 0.2, 0.5, 4.0
+
+
+def yaw_of(msg):
+    q = msg.pose.pose.orientation
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def wrap(a):
+    return math.atan2(math.sin(a), math.cos(a))
+
+
+class Latest:
+    def __init__(self):
+        self.lock = threading.Lock()
+        self.msg = None
+        self.count = 0
+
+    def __call__(self, msg):
+        with self.lock:
+            self.msg, self.count = msg, self.count + 1
+
+    def get(self):
+        with self.lock:
+            return self.msg
+
+
+class RealRobotTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_real_robot")
+        cls.cmd_topic = rospy.get_param("~cmd_topic")
+        cls.odom = Latest()
+        cls.truth = Latest()
+        cls.subs = [rospy.Subscriber(rospy.get_param("~odom_topic"), Odometry, cls.odom, queue_size=1),
+                    rospy.Subscriber(SIM + "/ground_truth", Odometry, cls.truth, queue_size=1)]
+        cls.pub = rospy.Publisher(cls.cmd_topic, Twist, queue_size=1)
+
+    def wait(self, predicate, timeout, what):
+        deadline = time.monotonic() + timeout
+        while not predicate():
+            if time.monotonic() > deadline or rospy.is_shutdown():
+                self.fail(f"timed out after {timeout} s waiting for {what}")
+            time.sleep(0.005)
+
+    def drive(self, linear, angular, seconds):
+        """Command (linear, angular) at 20 Hz of sim time for ``seconds``; returns (odom, truth) at start and end."""
+        start = (self.odom.get(), self.truth.get())
+        end_time = rospy.get_time() + seconds
+        msg = Twist()
+        msg.linear.x, msg.angular.z = linear, angular
+        while rospy.get_time() < end_time:
+            self.pub.publish(msg)
+            rospy.sleep(0.05)
+        end = (self.odom.get(), self.truth.get())
+        self.pub.publish(Twist())
+        return start, end
+
+    def stop(self, seconds=1.5):
+        end_time = rospy.get_time() + seconds
+        while rospy.get_time() < end_time:
+            self.pub.publish(Twist())
+            rospy.sleep(0.05)
+
+    def test_drives_straight_and_turns_in_place(self):
+        self.wait(lambda: self.odom.get() is not None and self.truth.get() is not None, 60.0,
+                  "the robot's odometry and the ground truth")
+        self.wait(lambda: self.pub.get_num_connections() > 0, 30.0, f"a subscriber on {self.cmd_topic}")
+        urdf_mass = rospy.get_param("~urdf_mass")
+        self.assertAlmostEqual(rospy.get_param(SIM + "/urdf_mass"), urdf_mass, delta=1e-6)
+        self.assertAlmostEqual(rospy.get_param(SIM + "/loaded_mass"), urdf_mass, delta=1e-3,
+                               msg="loaded mass differs from the URDF's")
+        self.stop(1.0)  # settle after the drop onto the ground
+
+        (o0, t0), (o1, t1) = self.drive(SPEED, 0.0, SECONDS)
+        self.stop()
+        for name, a, b in (("odometry", o0, o1), ("ground truth", t0, t1)):
+            p0, p1 = a.pose.pose.position, b.pose.pose.position
+            distance = math.hypot(p1.x - p0.x, p1.y - p0.y)
+            heading = abs(wrap(yaw_of(b) - yaw_of(a)))
+            rospy.loginfo(f"FIGURE straight[{name}]: {distance:.3f} m, heading change {heading:.3f} rad")
+            self.assertGreater(distance, 0.85 * SPEED * SECONDS, f"{name}: drove {distance:.3f} m")
+            self.assertLess(distance, 1.15 * SPEED * SECONDS, f"{name}: drove {distance:.3f} m")
+            self.assertLess(heading, 0.1, f"{name}: heading changed {heading:.3f} rad")
+
+        (o0, t0), (o1, t1) = self.drive(0.0, TURN, SECONDS)
+        self.stop()
+        turned = wrap(yaw_of(o1) - yaw_of(o0))
+        truth_turned = wrap(yaw_of(t1) - yaw_of(t0))
+        p0, p1 = t0.pose.pose.position, t1.pose.pose.position
+        moved = math.hypot(p1.x - p0.x, p1.y - p0.y)
+        rospy.loginfo(f"FIGURE turn: odometry {turned:.3f} rad, truth {truth_turned:.3f} rad, moved {moved:.3f} m")
+        self.assertGreater(turned, 0.8 * TURN * SECONDS, f"odometry turned {turned:.3f} rad")
+        self.assertLess(turned, 1.2 * TURN * SECONDS, f"odometry turned {turned:.3f} rad")
+        skid = rospy.get_param("~skid", False)
+        self.assertGreater(truth_turned, (0.25 if skid else 0.5) * TURN * SECONDS,
+                           f"the robot turned {truth_turned:.3f} rad")
+        self.assertLess(moved, 0.2 if skid else 0.1, f"turning in place moved the robot {moved:.3f} m")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("diffbot_sim", "test_real_robot", RealRobotTest, sys.argv)
