@@ -39,6 +39,21 @@ def next_due(due, period, now):
     return due
 
 
+def finite_twist(ctx, msg, owner):
+    """The six Twist fields of ``msg``, or None (with a throttled warning) when one is not finite: a NaN
+    must never reach the physics, and the robot keeps its last valid command, as diff_drive_controller."""
+    from .. import ros_msgs
+    from ..controller import non_finite_field
+
+    values = ros_msgs.twist_values(msg)
+    bad = non_finite_field(values)
+    if bad is not None:
+        ctx.sim.warn(f"nonfinite:{id(owner)}", f"ignored a velocity command with a non-finite {bad} {values}; "
+                     "the robot keeps its last valid command")
+        return None
+    return values
+
+
 @dataclass
 class RobotContext:
     """One robot as its plugins see it.

@@ -16,10 +16,10 @@ from nav_msgs.msg import Odometry
 
 from .. import config as cfgmod
 from .. import ros_msgs
-from ..controller import DiffDriveController, non_finite_field
+from ..controller import DiffDriveController
 from ..kinematics import quaternion_from_yaw
 from ..odometry import EncoderOdometry
-from .base import Plugin, join, next_due, publisher
+from .base import Plugin, finite_twist, join, next_due, publisher
 
 
 class DiffDrive(Plugin):
@@ -60,11 +60,8 @@ class DiffDrive(Plugin):
         """Keep the newest *valid* command and wake the loop, which applies it (at once in real time, at the
         next step in fast mode). Validating here means a good command followed by a NaN one keeps the good
         one, as diff_drive_controller does."""
-        values = ros_msgs.twist_values(msg)
-        bad = non_finite_field(values)
-        if bad is not None:
-            self.ctx.sim.warn(f"nonfinite:{id(self)}", f"ignored a cmd_vel with a non-finite {bad} {values}; "
-                              "the robot keeps its last valid command")
+        values = finite_twist(self.ctx, msg, self)
+        if values is None:
             return
         with self._lock:
             self._pending = values

@@ -25,11 +25,10 @@ from std_msgs.msg import Empty
 
 from .. import ros_msgs
 from ..config import _bool, _number, _string
-from ..controller import non_finite_field
 from ..errors import ModelError
 from ..kinematics import quaternion_from_yaw, wheel_speeds
 from ..model import tag_value
-from .base import Plugin, join, next_due, publisher
+from .base import Plugin, finite_twist, join, next_due, publisher
 from .joint_motors import UNLIMITED_EFFORT
 
 REQUIRED = ("left_wheel_joint_name", "right_wheel_joint_name", "wheel_separation", "wheel_diameter",
@@ -87,10 +86,8 @@ class Kobuki(Plugin):
 
     # -- callbacks ----------------------------------------------------------------------------------
     def _on_twist(self, msg):
-        values = ros_msgs.twist_values(msg)
-        bad = non_finite_field(values)
-        if bad is not None:
-            self.ctx.sim.warn(f"nonfinite:{id(self)}", f"ignored a velocity command with a non-finite {bad}")
+        values = finite_twist(self.ctx, msg, self)
+        if values is None:
             return
         with self._lock:
             self._pending = (values[0], values[5])

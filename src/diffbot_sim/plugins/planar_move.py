@@ -14,9 +14,8 @@ from nav_msgs.msg import Odometry
 
 from .. import ros_msgs
 from ..config import _bool, _number, _string
-from ..controller import non_finite_field
 from ..model import tag_value
-from .base import Plugin, join, next_due, publisher
+from .base import Plugin, finite_twist, join, next_due, publisher
 
 DEFAULTS = {"commandTopic": "cmd_vel", "odometryTopic": "odom", "odometryFrame": "odom",
             "robotBaseFrame": "base_footprint", "odometryRate": 20.0, "publishOdometryTf": True,
@@ -48,10 +47,8 @@ class PlanarMove(Plugin):
         self.summary_values = {k: v for k, v in values.items() if v is not None}
 
     def _on_twist(self, msg):
-        values = ros_msgs.twist_values(msg)
-        bad = non_finite_field(values)
-        if bad is not None:
-            self.ctx.sim.warn(f"nonfinite:{id(self)}", f"ignored a cmd_vel with a non-finite {bad}")
+        values = finite_twist(self.ctx, msg, self)
+        if values is None:
             return
         with self._lock:
             self._pending = (values[0], values[1], values[5])
