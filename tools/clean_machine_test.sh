@@ -21,6 +21,10 @@ log "debootstrap minbase bookworm into $DIR"
 debootstrap --variant=minbase bookworm "$DIR" http://deb.debian.org/debian >"$DIR.debootstrap.log" 2>&1 \
   || { tail -20 "$DIR.debootstrap.log"; exit 1; }
 cp /etc/resolv.conf "$DIR/etc/resolv.conf"
+# debootstrap writes no /etc/hosts (Debian's installer does): without it `localhost` does not resolve and no
+# ROS master can reach itself. Give the chroot what every installed Debian machine has.
+[ -s "$DIR/etc/hosts" ] || printf '127.0.0.1\tlocalhost\n127.0.1.1\t%s\n::1\tlocalhost ip6-localhost ip6-loopback\n' \
+  "$(hostname)" > "$DIR/etc/hosts"
 # This sandbox reaches PyPI through a TLS-intercepting proxy whose CA only the host trusts (its pip.conf
 # names the bundle). Hand the chroot the same trust, and nothing else of the host's configuration.
 if [ -f /etc/ssl/certs/ca-certificates.crt ]; then
