@@ -411,7 +411,7 @@ def _report(cfg, loaded):
         if item.spec.name:
             params.update({k: v for k, v in cfgmod.as_params(item.spec).items() if k != "name"})
         for key, value in params.items():
-            rospy.set_param(item.runtime.private + key, value)
+            rospy.set_param(item.runtime.private + key.strip("/"), value)
         params.update(cfgmod.as_params(cfg))
         summary = ", ".join(f"{k}={v}" for k, v in sorted(params.items()))
         rospy.loginfo(f"bullet_sim: {who}model {model.source} ({model.name}); {summary}")

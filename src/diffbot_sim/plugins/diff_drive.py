@@ -144,6 +144,9 @@ class DiffDrive(Plugin):
         params = cfgmod.as_params(self.drive)
         params["wheel_radius"] = self.drive.wheel_radius
         params["effective_max_wheel_velocity"] = self.max_wheel_velocity
+        params["cmd_vel_topic"] = self.cmd_sub.resolved_name
+        if self.odom_pub is not None:
+            params["odom_topic"] = self.odom_pub.resolved_name
         return params
 
 

@@ -80,7 +80,7 @@ class Kobuki(Plugin):
         self.tf_builder = ros_msgs.TransformBuilder(self.odom_frame, self.base_frame)
         self.js_builder = ros_msgs.JointStateBuilder(self.joints_)
         self.imu_frame = ctx.frame("base_link")
-        self.topics = {"cmd_vel": self.cmd_sub.resolved_name, "odom": self.odom_pub.resolved_name}
+        self.topics = {"cmd_vel_topic": self.cmd_sub.resolved_name, "odom_topic": self.odom_pub.resolved_name}
         ctx.warnings.append(f"{path}: {join(ns, prefix)}/commands/motor_power and events/cliff, events/bumper "
                             "are not simulated (their kobuki_msgs types are not in Debian)")
 

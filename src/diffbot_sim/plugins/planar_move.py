@@ -92,7 +92,7 @@ class PlanarMove(Plugin):
         self.command, self.stamp = (0.0, 0.0, 0.0), None
 
     def summary(self):
-        return dict(self.summary_values)
+        return dict(self.summary_values, cmd_vel_topic=self.sub.resolved_name, odom_topic=self.pub.resolved_name)
 
 
 def create(ctx, element, path, params):

@@ -272,7 +272,7 @@ class DiffDriveControllerRunner:
     def summary(self):
         return {f"{self.name}/wheel_separation": self.core.separation,
                 f"{self.name}/wheel_radius": self.core.left_radius,
-                f"{self.name}/cmd_vel": self.sub.resolved_name}
+                "cmd_vel_topic": self.sub.resolved_name, "odom_topic": self.odom_pub.resolved_name}
 
 
 class JointStateControllerRunner:
