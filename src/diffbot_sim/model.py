@@ -271,6 +271,9 @@ def _transmission(el, index, model):
         interfaces = [i.text for i in actuator.findall("hardwareInterface")]
     if not interfaces:
         raise ModelError("has no <hardwareInterface>", source, jpath)
+    if len(interfaces) > 1:  # gazebo_ros_control's DefaultRobotHWSim warns and uses the first
+        model.warnings.append(f"{source}: {jpath} declares {len(interfaces)} hardware interfaces; using the "
+                              f"first, {(interfaces[0] or '').strip()}, as gazebo_ros_control does")
     interface = (interfaces[0] or "").strip().split("/")[-1]
     if interface not in JOINT_INTERFACES:
         raise ModelError(f"hardware interface '{interfaces[0]}' is not one of {', '.join(JOINT_INTERFACES)}",

@@ -18,7 +18,8 @@ and starts the ones it knows:
 
 Motors (DefaultRobotHWSim): a velocity joint reaches its command with at most its URDF effort limit
 (unlimited without one: UNLIMITED_EFFORT); with ``<ns>/gazebo_ros_control/pid_gains/<joint>`` (p, i, d,
-i_clamp) it becomes VELOCITY_PID: effort = PID(velocity error) every physics step, clamped to the limit.
+i_clamp) it becomes VELOCITY_PID: effort = PID(velocity error) every physics step, clamped to the limit,
+where that loop is stable at our step (else an effort-limited velocity motor, with a warning).
 Effort joints get zero until commanded. ``eStopTopic`` (std_msgs/Bool) forces velocity commands to 0.
 Controllers update every ``controlPeriod`` (default CONTROL_PERIOD; Gazebo's default is the physics step).
 """
@@ -43,6 +44,9 @@ from .joint_motors import effort_limit
 #: every physics step (1 kHz in its default world); 100 Hz keeps real-time CPU low, and with velocity motors
 #: the wheels hold their targets between updates (PID joints are still driven every step).
 CONTROL_PERIOD = 0.01
+#: Largest p·dt/inertia for which an explicit velocity PID is simulated as such (a first-order discrete loop
+#: is stable below 2 and does not ring below 1; 0.5 leaves room for the I and D terms).
+STABLE_LOOP_GAIN = 0.5
 DEFAULT_SIM_TYPE = "gazebo_ros_control/DefaultRobotHWSim"
 JSC_TYPE = "joint_state_controller/JointStateController"
 JOINT_COMMAND_TYPES = {"velocity_controllers/JointVelocityController": "VelocityJointInterface",
@@ -98,6 +102,7 @@ class RosControl(Plugin):
                     ctx.warnings.append(f"{join(ns, 'gazebo_ros_control/pid_gains')}/{joint}: not numbers; "
                                         "the joint keeps a velocity motor")
         self.index = {j: robot.indices([j])[0] for j in self.interfaces if j in robot.joint_index}
+        self._check_pid_stability(ns)
         free = [self.index[j] for j, iface in self.interfaces.items()
                 if j in self.index and (iface == "EffortJointInterface" or j in self.pids)]
         robot.free_joints(free)
@@ -107,6 +112,26 @@ class RosControl(Plugin):
         self.controllers = []
         self.next_control = 0.0
         self.last_pid_time = None
+
+    def _check_pid_stability(self, ns):
+        """Keep the explicit PID only where its discrete loop is stable at our step.
+
+        Gains tuned for Gazebo's 1 ms step often are not at 1/240 s: measured on the PID fixture, p = 5 on a
+        1.9e-4 kg·m^2 wheel oscillates at +-85 rad/s. A loop gain p·dt/I above STABLE_LOOP_GAIN gets the
+        implicit form of the same loop instead: PyBullet's velocity motor, which the solver keeps at the
+        commanded velocity within the same effort limit (one warning names the joint)."""
+        dt = self.ctx.cfg.time_step
+        for joint in list(self.pids):
+            if joint not in self.index:
+                continue
+            inertia = self.ctx.robot.smallest_inertia(self.index[joint])
+            gain = self.pids[joint].p * dt / max(inertia, 1e-12)
+            if gain > STABLE_LOOP_GAIN:
+                self.ctx.warnings.append(
+                    f"{join(ns, 'gazebo_ros_control/pid_gains')}/{joint}: p={self.pids[joint].p:g} at a "
+                    f"{dt * 1000:.2f} ms step is an unstable loop on this joint (inertia {inertia:.2g} kg·m^2, "
+                    f"loop gain {gain:.3g}); it runs as an effort-limited velocity motor instead")
+                del self.pids[joint]
 
     def _on_estop(self, msg):
         self.estop = bool(msg.data)
