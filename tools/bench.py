@@ -12,6 +12,11 @@ Items (issue 4):
   latency    cmd_vel published -> wheel motor target applied (~debug/cmd_applied), wall ms, at RTF 1.
   startup    `roslaunch diffbot_sim sim.launch` -> first /odom, median of 5.
   scale      namespaced seed robots one simulator keeps at RTF >= 1, all topics subscribed.
+Items (issue 9):
+  meshes     roslaunch -> first /odom for a robot with 2 MB of binary STL meshes (collision and visual),
+             with an empty mesh cache and with the cache filled; median of 3 each.
+  ros_control  fast-mode RTF of the four-wheel ros_control fixture (diff_drive_controller from its YAML),
+             its odom, /joint_states and /tf each subscribed by a process of its own; median of 3.
 """
 import argparse
 import json
@@ -179,8 +184,8 @@ def probe_rtf(options):
         rospy.Subscriber(options.get("odom", "/odom"), Odometry,
                          lambda m: odom.append((time.monotonic(), m.header.stamp.to_sec())), queue_size=1000)
     _wait(lambda: len(clock) > 2, 60, "/clock")
-    pubs = [rospy.Publisher(f"{ns}/cmd_vel", Twist, queue_size=1, latch=True)
-            for ns in options.get("namespaces", [""])]
+    topics = options.get("cmd_topics") or [f"{ns}/cmd_vel" for ns in options.get("namespaces", [""])]
+    pubs = [rospy.Publisher(topic, Twist, queue_size=1, latch=True) for topic in topics]
     circle = Twist()
     circle.linear.x, circle.angular.z = 0.2, 0.5
     for pub in pubs:  # drive in circles: wheels, casters and contacts all busy
@@ -243,7 +248,8 @@ def probe_first_odom(options):
     from nav_msgs.msg import Odometry
     rospy.init_node("bench_first_odom", disable_signals=True)
     first = []
-    rospy.Subscriber("/odom", Odometry, lambda m: first or first.append(time.time()), queue_size=1)
+    rospy.Subscriber(options.get("odom", "/odom"), Odometry, lambda m: first or first.append(time.time()),
+                     queue_size=1)
     _wait(lambda: first, 60, "the first /odom")
     print(json.dumps({"first_odom_epoch": first[0]}), flush=True)
 
@@ -355,17 +361,20 @@ def bench_latency(count):
         return launch.probe("latency", count=count, rate=20.0, timeout=count / 20.0 + 120)
 
 
-def bench_startup(runs):
+def bench_startup(runs, extra=(), ros_home=None, before_each=None):
     times = []
     for i in range(runs):
+        if before_each is not None:
+            before_each()
         port = free_port()
-        env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}", ROS_HOME=os.path.join(RESULTS, "ros_home"))
+        env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}",
+                   ROS_HOME=ros_home or os.path.join(RESULTS, "ros_home"))
         probe = subprocess.Popen([sys.executable, os.path.abspath(__file__), "--probe", "first_odom", "--options", "{}"],
                                  env=env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
         time.sleep(0.5)  # the probe is up and polling for the master before the clock starts
         start = time.time()
         with open(os.path.join(RESULTS, f"startup{i}.log"), "w") as log:
-            proc = subprocess.Popen(["roslaunch", "-p", str(port)] + sim_args(), env=env, stdout=log,
+            proc = subprocess.Popen(["roslaunch", "-p", str(port)] + sim_args(*extra), env=env, stdout=log,
                                     stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, start_new_session=True)
             try:
                 out, _ = probe.communicate(timeout=90)
@@ -378,6 +387,62 @@ def bench_startup(runs):
                     os.killpg(proc.pid, signal.SIGKILL)
                     proc.wait()
     return {"median_s": statistics.median(times), "runs_s": times}
+
+
+def mesh_robot():
+    """A two-wheel robot whose base is a 2 MB binary STL (collision and visual), written once into RESULTS."""
+    sys.path.insert(0, HERE)
+    from mesh_speed import sphere_stl
+    folder = os.path.join(RESULTS, "mesh_robot")
+    os.makedirs(folder, exist_ok=True)
+    stl = os.path.join(folder, "base.stl")
+    if not os.path.exists(stl):
+        sphere_stl(stl)
+    with open(os.path.join(ROOT, "tests", "data", "robots", "fixed_caster.urdf")) as f:
+        text = f.read()
+    mesh = '<geometry><mesh filename="base.stl" scale="0.001 0.001 0.001"/></geometry>'
+    text = text.replace('<visual><geometry><box size="0.2 0.15 0.04"/></geometry></visual>',
+                        f'<visual><origin xyz="0 0 0.2"/>{mesh}</visual>')
+    text = text.replace('<collision><geometry><box size="0.2 0.15 0.04"/></geometry></collision>',
+                        f'<collision><origin xyz="0 0 0.2"/>{mesh}</collision>', 1)
+    path = os.path.join(folder, "mesh_robot.urdf")
+    with open(path, "w") as f:
+        f.write(text)
+    return path, os.path.getsize(stl)
+
+
+def bench_meshes(runs):
+    """Start-up to first /odom with 2 MB of STL: every run with an empty mesh cache, then with it filled."""
+    import shutil
+    path, size = mesh_robot()
+    home = os.path.join(RESULTS, "ros_home_meshes")
+    cache = os.path.join(home, "diffbot_sim", "mesh_cache")
+    cold = bench_startup(runs, (f"model:={path}", "robot_state_publisher:=false"), home,
+                         lambda: shutil.rmtree(cache, ignore_errors=True))
+    warm = bench_startup(runs, (f"model:={path}", "robot_state_publisher:=false"), home)
+    return {"stl_bytes": size, "cold": cold, "cached": warm}
+
+
+ROS_CONTROL_MODEL = os.path.join(ROOT, "tests", "data", "robots", "ros_control_4wd.urdf")
+ROS_CONTROL_YAML = os.path.join(ROOT, "tests", "data", "robots", "ros_control_4wd.yaml")
+
+
+def ros_control_trial(seconds):
+    args = sim_args("real_time:=false", f"model:={ROS_CONTROL_MODEL}", f"controllers:={ROS_CONTROL_YAML}",
+                    "robot_state_publisher:=false")
+    with Launch(args, "ros_control") as launch:
+        for topic in ("/mobile_base_controller/odom", "/joint_states", "/tf"):
+            subscriber(launch, [topic])
+        result = launch.probe("rtf", seconds=seconds, warmup=3.0, cmd_topics=["/mobile_base_controller/cmd_vel"])
+        counts = launch.stop_children()
+    result["subscriber_messages"] = {k: v for c in counts if c for k, v in c.items()}
+    return result
+
+
+def bench_ros_control(seconds, repeats):
+    trials = [ros_control_trial(seconds) for _ in range(repeats)]
+    rtfs = [t["rtf"] for t in trials]
+    return dict(trials[rtfs.index(statistics.median_low(rtfs))], rtf=statistics.median(rtfs), rtf_runs=rtfs)
 
 
 def scale_launch(count, rsp):
@@ -468,6 +533,13 @@ def table(r):
                      f"p99 <= {1000 * STEP + 2:.2f} ms"))
     if r.get("startup"):
         rows.append(("roslaunch -> first /odom (median of 5)", f"{r['startup']['median_s']:.2f} s", "<= 3 s"))
+    if r.get("meshes"):
+        m = r["meshes"]
+        rows += [(f"first /odom, {m['stl_bytes'] / 1e6:.1f} MB STL, empty mesh cache", f"{m['cold']['median_s']:.2f} s",
+                  "<= 2 s"),
+                 ("  same, mesh cache filled", f"{m['cached']['median_s']:.2f} s", "")]
+    if r.get("ros_control"):
+        rows.append(("fast-mode RTF, 4-wheel ros_control robot (DDC)", f"{r['ros_control']['rtf']:.1f}", ">= 30"))
     for key, label in (("scale", "robots at RTF >= 1 (all topics)"),
                        ("scale_rsp", "  same, + robot_state_publisher each")):
         if r.get(key):
@@ -485,7 +557,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--probe", choices=sorted(PROBES), help=argparse.SUPPRESS)
     parser.add_argument("--options", default="{}", help=argparse.SUPPRESS)
-    parser.add_argument("--only", default="fast,realtime,latency,startup,scale",
+    parser.add_argument("--only", default="fast,realtime,latency,startup,scale,meshes,ros_control",
                         help="comma-separated items to run (default: all)")
     parser.add_argument("--quick", action="store_true", help="shorter windows (smoke run, not for figures)")
     args = parser.parse_args()
@@ -499,7 +571,9 @@ def main():
     steps = [("fast", lambda: bench_fast(4 if q else 12, 1 if q else 3)),
              ("realtime", lambda: bench_realtime(10 if q else 60)), ("latency", lambda: bench_latency(100 if q else 600)),
              ("startup", lambda: bench_startup(2 if q else 5)), ("scale", lambda: bench_scale(4 if q else 8, False)),
-             ("scale_rsp", lambda: bench_scale(4 if q else 8, True))]
+             ("scale_rsp", lambda: bench_scale(4 if q else 8, True)),
+             ("meshes", lambda: bench_meshes(1 if q else 3)),
+             ("ros_control", lambda: bench_ros_control(4 if q else 12, 1 if q else 3))]
     for name, run in steps:
         wanted = name in items or (name == "scale_rsp" and "scale" in items)
         if not wanted:

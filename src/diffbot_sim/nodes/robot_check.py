@@ -1,0 +1,437 @@
+"""``rosrun diffbot_sim robot_check <model> [controller.yaml ...] [-- xacro args]``: the migration check.
+
+Someone moving a robot from Gazebo wants one screen that says whether it drives here, and if not, why. The
+static part (mass, drive and where its geometry came from, plugins, warnings) comes from
+:mod:`diffbot_sim.robot_report`, in this process. Then the robot is driven for real: a private master
+(``roscore -p <free port>``), the controller YAMLs loaded onto it, ``bullet_sim`` headless in fast mode
+with ground truth, and this process as a node publishing the commands and judging the motions with
+:mod:`diffbot_sim.drive_check` (the rules the fixture-robot rostests use).
+
+Fast mode, with ``~fast_batch`` 0: the batched writes of fast mode deliver ``/clock`` and odometry up to
+5 ms of wall time late, which at 40x real time is long enough for a DiffDriveController with
+``cmd_vel_timeout: 0.25`` to see its commands go stale (README "Fast mode is not lockstep"). Without
+batching each message goes out as it is made, and the 20 Hz (sim time) commands arrive in time.
+
+Exit status: 0 when both motions pass, 1 when they do not (or the model or the simulator fails: one line
+naming the file, element or parameter), 2 on bad usage. Every process started is stopped, by its pid and
+its session, before the exit.
+"""
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+
+from .. import drive_check, robot_report, streams
+from ..errors import DiffbotSimError, ModelError
+
+USAGE = ("usage: rosrun diffbot_sim robot_check <model.urdf|model.urdf.xacro> [controller.yaml ...] "
+         "[-- xacro args name:=value ...]")
+SIM = "/bullet_sim"
+#: Private parameters of bullet_sim for the check: headless, as fast as it can, no batching (see above).
+SIM_PARAMS = {"real_time": False, "fast_batch": 0.0, "publish_ground_truth": True, "gui": False}
+MASTER_TIMEOUT = 20.0  # s (wall) for roscore to answer
+START_TIMEOUT = 60.0  # s (wall) for bullet_sim to load the model and report its settings
+TOPIC_TIMEOUT = 20.0  # s (wall) for the first odometry, ground truth and the command connection
+DRIVE_TIMEOUT = 120.0  # s (wall) for the whole drive (sim time stops if bullet_sim dies)
+SETTLE, PAUSE = 1.0, 1.5  # s (sim) at rest before the first motion and after each
+
+
+class UsageError(Exception):
+    """The command line is not ``<model> [controller.yaml ...] [-- xacro args]``."""
+
+
+def parse_argv(argv):
+    """``(model, [yaml, ...], "xacro args")`` from the arguments after the program name.
+
+    Tokens with ``:=`` count as xacro arguments also before ``--`` (what a user forgetting it means).
+
+    Raises:
+        UsageError: no model, or an option this tool does not have.
+    """
+    files, xacro_args = [], []
+    rest = list(argv)
+    if "--" in rest:
+        cut = rest.index("--")
+        rest, xacro_args = rest[:cut], rest[cut + 1:]
+    for token in rest:
+        if ":=" in token:
+            xacro_args.append(token)
+        elif token.startswith("-"):
+            raise UsageError(f"unknown option {token}")
+        else:
+            files.append(token)
+    if not files:
+        raise UsageError("no model given")
+    return files[0], files[1:], " ".join(xacro_args)
+
+
+def main(argv=None):
+    """Entry point; returns the exit status (0 drives, 1 does not or bad input, 2 bad usage).
+
+    Output that cannot be written (``robot_check ... | head -3``) never changes the status:
+    :func:`diffbot_sim.streams.finish` empties the buffers first.
+    """
+    try:
+        return _main(sys.argv[1:] if argv is None else argv)
+    finally:
+        streams.finish()
+
+
+def _say(line=""):
+    streams.write(sys.stdout, line + "\n")
+
+
+def _main(argv):
+    if any(a in ("-h", "--help") for a in argv[:argv.index("--") if "--" in argv else len(argv)]):
+        _say(USAGE)
+        return 0
+    try:
+        model, yamls, model_args = parse_argv(argv)
+    except UsageError as err:
+        streams.write(sys.stderr, f"robot_check: {err}\n{USAGE}\n")
+        return 2
+    model = os.path.abspath(os.path.expanduser(model))
+    yamls = [os.path.abspath(os.path.expanduser(y)) for y in yamls]
+    try:
+        files = [(path, _load_yaml(path)) for path in yamls]
+        from ..plugins.registry import KNOWN
+        report = robot_report.build_report(model, model_args, [(p, tree) for p, (tree, _) in files], KNOWN,
+                                           _package_path)
+    except DiffbotSimError as err:
+        streams.write(sys.stderr, f"robot_check: {err}\n")
+        return 1
+    for line in robot_report.format_report(report):
+        _say(line)
+    if report.drive is None:
+        _say("result: FAIL: no drive was found, so there is nothing to drive")
+        return 1
+    signal.signal(signal.SIGTERM, _terminate)
+    try:
+        with Session(model, model_args, [docs for _, (_, docs) in files]) as session:
+            return _drive(session, report)
+    except SessionError as err:
+        _say(f"result: FAIL: {err}")
+        return 1
+    except KeyboardInterrupt:
+        streams.write(sys.stderr, "robot_check: interrupted\n")
+        return 130
+
+
+def _terminate(signum, frame):
+    raise KeyboardInterrupt
+
+
+def _load_yaml(path):
+    """``(tree, documents)`` of a controller YAML as rosparam loads it (``!degrees`` and all).
+
+    Raises:
+        ModelError: the file is missing or not YAML rosparam can load (naming the file).
+    """
+    import rosparam
+
+    if not os.path.isfile(path):
+        raise ModelError("no such file", path)
+    try:
+        docs = rosparam.load_file(path, default_namespace="/")
+    except Exception as err:  # noqa: BLE001 - rosparam raises RosParamException, yaml errors, ...
+        detail = " ".join(str(err).split()) or type(err).__name__
+        raise ModelError(f"not a controller YAML rosparam can load ({detail})", path) from None
+    tree = {}
+    for values, ns in docs:
+        if not isinstance(values, dict):
+            raise ModelError(f"not a mapping of parameters (a {type(values).__name__})", path)
+        robot_report.merge_params(tree, ns or "/", values)
+    return tree, docs
+
+
+def _package_path(package):
+    import rospkg
+
+    try:
+        return rospkg.RosPack().get_path(package)
+    except rospkg.ResourceNotFound as err:
+        raise LookupError(package) from err
+
+
+# ------------------------------------------------------------------------------------------- processes
+
+class SessionError(Exception):
+    """The private master or the simulator did not come up or died (one line saying which and why)."""
+
+
+def _free_port():
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def _tree(root):
+    """Live pids of ``root`` and its descendants (roslaunch starts rosmaster/rosout as its children)."""
+    children = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as handle:
+                    fields = handle.read().rsplit(")", 1)[1].split()
+            except (OSError, IndexError):
+                continue
+            if fields[0] != "Z":
+                children.setdefault(int(fields[1]), []).append(int(entry))
+    found, todo = [], [root]
+    while todo:
+        pid = todo.pop()
+        found.append(pid)
+        todo.extend(children.get(pid, []))
+    return found
+
+
+class _Child:
+    """A process in its own session, output to a log file; stopped with SIGINT, then SIGKILL."""
+
+    def __init__(self, argv, env, log_path):
+        self.log_path = log_path
+        with open(log_path, "w") as log:
+            self.popen = subprocess.Popen(argv, env=env, stdout=log, stderr=subprocess.STDOUT,
+                                          stdin=subprocess.DEVNULL, start_new_session=True, close_fds=True)
+
+    def alive(self):
+        return self.popen.poll() is None
+
+    def log(self):
+        try:
+            with open(self.log_path, errors="replace") as handle:
+                return handle.read()
+        except OSError:
+            return ""
+
+    def stop(self, timeout):
+        pid = self.popen.pid
+        seen = set(_tree(pid)) if self.alive() else set()
+        if self.alive():
+            try:
+                os.kill(pid, signal.SIGINT)
+            except ProcessLookupError:
+                pass
+            try:
+                self.popen.wait(timeout)
+            except subprocess.TimeoutExpired:
+                pass
+        for other in seen | set(_tree(pid) if self.alive() else ()):
+            try:
+                os.kill(other, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                pass
+        try:
+            os.killpg(pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
+        try:
+            self.popen.wait(10)
+        except subprocess.TimeoutExpired:
+            pass
+
+
+class Session:
+    """A private master with the controller parameters, and bullet_sim on it; this process joins as a node.
+
+    ``ROS_MASTER_URI`` and ``ROS_LOG_DIR`` (a temporary directory, removed at the end) are set in this
+    process's environment, as rospy and rosparam read them there.
+    """
+
+    def __init__(self, model, model_args, yaml_docs):
+        self.model, self.model_args, self.yaml_docs = model, model_args, yaml_docs
+        self.master = self.sim = None
+        self.tmp = None
+
+    def __enter__(self):
+        self.tmp = tempfile.mkdtemp(prefix="robot_check_")
+        try:
+            self._start()
+        except BaseException:
+            self.__exit__(None, None, None)
+            raise
+        return self
+
+    def _start(self):
+        import rosgraph
+        import rosparam
+
+        for attempt in range(3):  # a free port can be taken between the probe and roscore binding it
+            port = _free_port()
+            os.environ["ROS_MASTER_URI"] = f"http://localhost:{port}"
+            os.environ["ROS_LOG_DIR"] = self.tmp
+            env = dict(os.environ)
+            env.pop("PYTHONUNBUFFERED", None)
+            self.master = _Child(["roscore", "-p", str(port)], env, os.path.join(self.tmp, "roscore.log"))
+            api = rosgraph.Master("/robot_check", master_uri=os.environ["ROS_MASTER_URI"])
+            deadline = time.monotonic() + MASTER_TIMEOUT
+            while not api.is_online():
+                if not self.master.alive() or time.monotonic() > deadline:
+                    break
+                time.sleep(0.05)
+            if api.is_online():
+                break
+            self.master.stop(5.0)
+            self.master = None
+        else:
+            raise SessionError(f"roscore did not start (log: {self.tmp}/roscore.log)")
+        for docs in self.yaml_docs:
+            for values, ns in docs:
+                rosparam.upload_params(ns or "/", values)
+        api.setParam("/use_sim_time", True)
+        params = dict(SIM_PARAMS, model=self.model, model_args=self.model_args)
+        for key, value in params.items():
+            api.setParam(f"{SIM}/{key}", value)
+        self.sim = _Child(["rosrun", "diffbot_sim", "bullet_sim"], env, os.path.join(self.tmp, "bullet_sim.log"))
+        self.api = api
+
+    def sim_failure(self):
+        """bullet_sim's FATAL line (or its last line) once it has exited; None while it runs."""
+        if self.sim is None or self.sim.alive():
+            return None
+        lines = [line.strip() for line in self.sim.log().splitlines() if line.strip()]
+        fatal = [line for line in lines if line.startswith("[FATAL]")]
+        text = (fatal or lines or ["(no output)"])[-1]
+        return f"bullet_sim exited ({self.sim.popen.returncode}): {_message(text)}"
+
+    def sim_warnings(self):
+        """The warnings bullet_sim has logged, without rospy's ``[WARN] [time]:`` prefix."""
+        return [_message(line) for line in self.sim.log().splitlines() if line.startswith("[WARN]")]
+
+    def __exit__(self, *exc):
+        try:
+            import rospy
+
+            if rospy.core.is_initialized():
+                rospy.signal_shutdown("robot_check done")
+        except ImportError:
+            pass
+        if self.sim is not None:
+            self.sim.stop(5.0)
+        if self.master is not None:
+            self.master.stop(10.0)
+        if self.tmp is not None:
+            shutil.rmtree(self.tmp, ignore_errors=True)
+        return False
+
+
+def _message(line):
+    """``[WARN] [1700000000.1, 2.0]: text`` -> ``text``."""
+    if line.startswith("[") and "]: " in line:
+        return line.split("]: ", 1)[1]
+    return line
+
+
+# ----------------------------------------------------------------------------------------------- drive
+
+class _Latest:
+    """The newest message of a topic as an ``(x, y, yaw)`` pose (callbacks only store)."""
+
+    def __init__(self):
+        self.lock = threading.Lock()
+        self.pose = None
+
+    def __call__(self, msg):
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        pose = (p.x, p.y, drive_check.yaw_from_quaternion(q.x, q.y, q.z, q.w))
+        with self.lock:
+            self.pose = pose
+
+    def get(self):
+        with self.lock:
+            return self.pose
+
+
+def _wait(predicate, timeout, what, session):
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        failure = session.sim_failure()
+        if failure:
+            raise SessionError(failure)
+        if time.monotonic() > deadline:
+            raise SessionError(f"timed out after {timeout:g} s waiting for {what} (bullet_sim log: "
+                               f"{session.sim.log_path}, removed at exit)")
+        time.sleep(0.01)
+
+
+def _drive(session, report):
+    import rospy
+    from geometry_msgs.msg import Twist
+    from nav_msgs.msg import Odometry
+
+    rospy.init_node("robot_check", anonymous=True, argv=[sys.argv[0]], disable_signals=True)
+    _wait(lambda: rospy.has_param(SIM + "/loaded_mass"), START_TIMEOUT, "bullet_sim to load the model", session)
+    cmd_topic = rospy.get_param(SIM + "/cmd_vel_topic", None)
+    odom_topic = rospy.get_param(SIM + "/odom_topic", None)
+    _say(f"drive test: bullet_sim headless, fast mode; {cmd_topic} -> {odom_topic} and {SIM}/ground_truth")
+    logged = session.sim_warnings()
+    extra = [w for w in logged if w not in report.warnings]
+    for text in extra[:robot_report.MAX_WARNINGS]:
+        _say(f"  bullet_sim also warned: {text}")
+    if not cmd_topic or not odom_topic:
+        raise SessionError("bullet_sim reports no command or odometry topic for the drive "
+                           f"({SIM}/cmd_vel_topic, {SIM}/odom_topic)")
+    odom, truth = _Latest(), _Latest()
+    subs = [rospy.Subscriber(odom_topic, Odometry, odom, queue_size=1),
+            rospy.Subscriber(SIM + "/ground_truth", Odometry, truth, queue_size=1)]
+    pub = rospy.Publisher(cmd_topic, Twist, queue_size=1)
+    _wait(lambda: odom.get() is not None and truth.get() is not None, TOPIC_TIMEOUT,
+          f"{odom_topic} and {SIM}/ground_truth", session)
+    _wait(lambda: pub.get_num_connections() > 0, TOPIC_TIMEOUT, f"bullet_sim to subscribe {cmd_topic}", session)
+
+    watchdog = threading.Thread(target=_watch, args=(session, time.monotonic() + DRIVE_TIMEOUT), daemon=True)
+    watchdog.start()
+    try:
+        _command(pub, 0.0, 0.0, SETTLE)
+        start = (odom.get(), truth.get())
+        _command(pub, drive_check.SPEED, 0.0, drive_check.SECONDS)
+        end = (odom.get(), truth.get())
+        _command(pub, 0.0, 0.0, PAUSE)
+        straight = drive_check.straight(start[0], end[0], start[1], end[1])
+        start = (odom.get(), truth.get())
+        _command(pub, 0.0, drive_check.TURN, drive_check.SECONDS)
+        end = (odom.get(), truth.get())
+        _command(pub, 0.0, 0.0, PAUSE)
+        turn = drive_check.turn(start[0], end[0], start[1], end[1])
+    except rospy.ROSInterruptException:
+        raise SessionError(session.sim_failure() or f"the drive took longer than {DRIVE_TIMEOUT:g} s "
+                           "of wall time (sim time stopped?)") from None
+    finally:
+        for sub in subs:
+            sub.unregister()
+    for line in robot_report.format_motions(straight, turn):
+        _say(line)
+    if straight.passed and turn.passed:
+        _say("result: PASS: the robot drives")
+        return 0
+    _say("result: FAIL: the robot does not drive as commanded")
+    return 1
+
+
+def _command(pub, linear, angular, seconds):
+    """Publish (linear, angular) at COMMAND_RATE of sim time for ``seconds`` of sim time."""
+    import rospy
+    from geometry_msgs.msg import Twist
+
+    msg = Twist()
+    msg.linear.x, msg.angular.z = linear, angular
+    end = rospy.get_time() + seconds
+    while rospy.get_time() < end:
+        pub.publish(msg)
+        rospy.sleep(1.0 / drive_check.COMMAND_RATE)
+
+
+def _watch(session, deadline):
+    """Shut rospy down (so a sim-time sleep returns) when bullet_sim dies or the drive overruns."""
+    import rospy
+
+    while not rospy.is_shutdown():
+        if session.sim_failure() or time.monotonic() > deadline:
+            rospy.signal_shutdown("bullet_sim stopped or the drive overran")
+            return
+        time.sleep(0.1)

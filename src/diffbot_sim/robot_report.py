@@ -1,0 +1,385 @@
+"""What ``robot_check`` says about a model before driving it: mass, drive, plugins, warnings (pure).
+
+A user migrating from Gazebo wants to know, in one screen, whether the simulator reads their robot as Gazebo
+did: which plugin or controller drives it, where each number of its geometry came from (a tag, a YAML
+parameter, or measured from the URDF as diff_drive_controller measures it), what is not simulated, and what
+``bullet_sim`` will warn about. This module answers from the same pure units the simulator uses (description,
+model, plugins.tags, config, ddc, meshes, physics), without a ROS master; :func:`build_report` returns plain
+data and :func:`format_report` turns it into lines. Controller YAML files are passed in already loaded
+(``rosparam.load_file`` in the node), so nothing here needs ROS.
+"""
+import math
+import os
+from dataclasses import dataclass, field
+from typing import List, Optional
+
+from . import config as cfgmod
+from . import ddc, meshes
+from .description import load_file, parse_args
+from .model import parse_urdf, tag_value
+from .plugins.tags import DIFF_DRIVE, JOINT_STATE, read_plugins
+
+SKID_STEER = "libgazebo_ros_skid_steer_drive.so"
+PLANAR_MOVE = "libgazebo_ros_planar_move.so"
+KOBUKI = "libgazebo_ros_kobuki.so"
+ROS_CONTROL = "libgazebo_ros_control.so"
+DEFAULT_SIM_TYPE = "gazebo_ros_control/DefaultRobotHWSim"
+#: The sentence bullet_sim logs when nothing can move the robot (sim_node's start-up report).
+NO_DRIVE = ("the model has no drive plugin or controller that bullet_sim simulates (and no ~left_joints): "
+            "nothing moves it")
+#: Loaded and URDF mass may differ by this much [kg] (an inertia-less root weighs 1 mg in PyBullet).
+MASS_TOLERANCE = 1e-3
+
+
+@dataclass
+class Drive:
+    """The plugin or controller that moves the robot, and where its geometry came from."""
+
+    kind: str  # plugin filename or controller type
+    where: str  # element path, or ``/controller from file.yaml``
+    left: List[str] = field(default_factory=list)
+    right: List[str] = field(default_factory=list)
+    separation: Optional[float] = None  # m, as used (multiplier applied)
+    separation_from: str = ""
+    radius: Optional[float] = None  # m, as used (multiplier applied)
+    radius_from: str = ""
+    note: str = ""  # e.g. "holonomic: no wheels"
+
+
+@dataclass
+class Item:
+    """One plugin, sensor or controller of the model, and whether bullet_sim simulates it."""
+
+    kind: str  # "plugin", "sensor" or "controller"
+    name: str
+    what: str  # filename, sensor type or controller type
+    where: str
+    simulated: bool
+
+
+@dataclass
+class Report:
+    source: str
+    name: str
+    urdf_mass: float  # kg
+    loaded_mass: float  # kg
+    drives: List[Drive] = field(default_factory=list)
+    items: List[Item] = field(default_factory=list)
+    warnings: List[str] = field(default_factory=list)
+
+    @property
+    def drive(self):
+        """The drive the simulator runs first (None: nothing moves the robot)."""
+        return self.drives[0] if self.drives else None
+
+
+# ----------------------------------------------------------------------------------------- parameters
+
+def merge_params(tree, namespace, values):
+    """Put ``values`` under ``namespace`` in the nested dict ``tree``, dicts merged key by key as
+    ``rosparam load`` updates the parameter server (a later file wins per key, not per subtree)."""
+    node = tree
+    for part in [p for p in namespace.split("/") if p]:
+        if not isinstance(node.get(part), dict):
+            node[part] = {}
+        node = node[part]
+    _update(node, values)
+    return tree
+
+
+def _update(node, values):
+    for key, value in values.items():
+        if isinstance(value, dict):
+            if not isinstance(node.get(key), dict):
+                node[key] = {}
+            _update(node[key], value)
+        else:
+            node[key] = value
+
+
+def _subtree(tree, namespace):
+    node = tree
+    for part in [p for p in namespace.split("/") if p]:
+        node = node.get(part) if isinstance(node, dict) else None
+    return node if isinstance(node, dict) else {}
+
+
+def find_controllers(tree, namespace):
+    """{controller namespace: parameters} of every dict with a ``pkg/Type`` under ``namespace``; none there:
+    anywhere in ``tree``. The walk gazebo_ros_control's stand-in (plugins.ros_control) makes on the server."""
+    def walk(prefix, node, out):
+        if not isinstance(node, dict):
+            return
+        if isinstance(node.get("type"), str) and "/" in node["type"]:
+            out[prefix] = node
+            return
+        for key, value in node.items():
+            if key != "gazebo_ros_control":
+                walk(prefix.rstrip("/") + "/" + key, value, out)
+
+    ns = "/" + namespace.strip("/")
+    found = {}
+    walk(ns, _subtree(tree, ns), found)
+    if not found and ns != "/":
+        walk("/", tree, found)
+    return found
+
+
+# --------------------------------------------------------------------------------------------- report
+
+def build_report(path, model_args="", controller_files=(), known=None, resolve_package=None, cache_dir=None):
+    """Load ``path`` as bullet_sim would and describe it.
+
+    Args:
+        path: .urdf or .urdf.xacro.
+        model_args: xacro arguments, ``"a:=1 b:=2"``.
+        controller_files: ``[(file, tree)]``: each controller YAML and its parameters as loaded at ``/``
+            (``rosparam.load_file``), in the order they are loaded.
+        known: plugin filenames bullet_sim simulates (``plugins.registry.KNOWN``); None imports it.
+        resolve_package: ``pkg -> path`` for ``package://`` meshes (LookupError when unknown); None: every
+            package is unknown.
+        cache_dir: converted-mesh cache; None: the user's (``meshes.default_cache_dir()``).
+
+    Returns:
+        Report.
+
+    Raises:
+        ModelError, ConfigError: what would stop bullet_sim, naming the file, element or parameter.
+    """
+    if known is None:
+        from .plugins.registry import KNOWN as known  # imports the plugin modules (and rospy) only here
+    source = os.path.abspath(os.path.expanduser(path))
+    text = load_file(source, parse_args(model_args))
+    model = parse_urdf(text, source)
+    text, mesh_notes = meshes.prepare_meshes(text, source, os.path.dirname(source),
+                                             cache_dir or meshes.default_cache_dir(),
+                                             resolve_package or _no_package)
+    found = read_plugins(model, known=known)
+    for trans in model.transmissions:
+        model.joint(trans.joint, f"/robot/transmission[@name='{trans.name}']")
+    tree = {}
+    origin = {}  # controller namespace -> the file that last set it
+    for name, values in controller_files:
+        merge_params(tree, "/", values)
+        for ns in find_controllers(values, "/"):
+            origin[ns] = os.path.basename(name)
+
+    warnings = list(found.warnings)
+    cfgmod.take_notes()  # start clean: the notes are a module-global list
+    drives, items = [], []
+    block = found.diff_drive
+    if block is not None:
+        drives.append(_diff_drive(model, block))
+        items.append(Item("plugin", _name_of(block.path, DIFF_DRIVE), DIFF_DRIVE, block.path, True))
+    if found.joint_state is not None:
+        js = found.joint_state
+        items.append(Item("plugin", _name_of(js.path, JOINT_STATE), JOINT_STATE, js.path, True))
+    for other in found.others:
+        items.append(Item("plugin", other.name, other.filename, other.path, other.filename in known))
+        if other.filename not in known:
+            continue
+        values = {child.tag: tag_value(child) for child in other.element}
+        if other.filename == SKID_STEER:
+            drives.append(_skid_steer(model, values, other.path))
+        elif other.filename == KOBUKI:
+            drives.append(_kobuki(values, other.path))
+        elif other.filename == PLANAR_MOVE:
+            drives.append(Drive(PLANAR_MOVE, other.path, note="holonomic: sets the body's velocity, no wheels"))
+        elif other.filename == ROS_CONTROL:
+            ns = values.get("robotNamespace") or "/"
+            sim_type = values.get("robotSimType") or DEFAULT_SIM_TYPE
+            if sim_type != DEFAULT_SIM_TYPE:
+                warnings.append(f"{other.path}: robotSimType '{sim_type}' is not simulated; using {DEFAULT_SIM_TYPE}")
+            controllers = find_controllers(tree, ns)
+            if not controllers:
+                warnings.append(f"{other.path}: no controller found on the parameter server under {ns} (load "
+                                "your controller YAML with <rosparam command=\"load\"> before bullet_sim starts)")
+            for name, params in sorted(controllers.items()):
+                kind = params.get("type")
+                simulated = kind in (ddc.CONTROLLER_TYPE, "joint_state_controller/JointStateController",
+                                     "velocity_controllers/JointVelocityController",
+                                     "position_controllers/JointPositionController",
+                                     "effort_controllers/JointEffortController")
+                file = origin.get(name, "?")
+                items.append(Item("controller", name, kind, f"from {file}", simulated))
+                if not simulated:
+                    warnings.append(f"{name}: controller type {kind} is not simulated")
+                if kind == ddc.CONTROLLER_TYPE:
+                    drive, notes = _ddc(model, name, params, file)
+                    drives.append(drive)
+                    warnings.extend(notes)
+    for gazebo in model.gazebo:
+        for el in gazebo.element.iter("sensor"):
+            name = el.get("name") or "?"
+            items.append(Item("sensor", name, el.get("type") or "?", f"{gazebo.path}/sensor[@name='{name}']", False))
+    warnings.extend(cfgmod.take_notes())
+    for blk in (found.diff_drive, found.joint_state):
+        if blk is not None and blk.unknown_tags:
+            warnings.append(f"{blk.path}: unknown tags ignored: {', '.join(blk.unknown_tags)}")
+
+    from .physics import World  # PyBullet, only once the model is known to be good
+
+    world = World(1.0 / 240.0)
+    try:
+        loaded_mass = world.load_robot(text, model).total_mass()
+    finally:
+        world.close()
+    # model.warnings grows while loading (surface tags are read then), so it is taken last.
+    warnings = model.warnings + mesh_notes + warnings
+    if found.unsupported:
+        warnings.append("not simulated (ignored): " + "; ".join(found.unsupported))
+    if not drives:
+        warnings.append(NO_DRIVE)
+    return Report(source, model.name, model.total_mass(), loaded_mass, drives, items, _unique(warnings))
+
+
+def _no_package(package):
+    raise LookupError(package)
+
+
+def _unique(lines):
+    seen, out = set(), []
+    for line in lines:
+        if line not in seen:
+            seen.add(line)
+            out.append(line)
+    return out
+
+
+def _name_of(path, default):
+    return path.split("@name='", 1)[1].split("'", 1)[0] if "@name='" in path else default
+
+
+def _measured_radius(model, joint):
+    link = model.links[model.joints[joint].child]
+    kind = next((g.kind for g in link.collisions if g.kind in ("cylinder", "sphere")), "?")
+    return f"measured: {kind} collision of {link.name}"
+
+
+def _measured_separation(left, right):
+    return f"measured: origins of {left} and {right}"
+
+
+def _diff_drive(model, block):
+    cfg = cfgmod.drive_config(model, block, {})
+    left, right = cfg.left_joints[0], cfg.right_joints[0]
+    sep_from = (f"<{block.tag('wheel_separation')}> tag" if "wheel_separation" in block.values
+                else _measured_separation(left, right))
+    rad_from = (f"<{block.tag('wheel_diameter')}> tag / 2" if "wheel_diameter" in block.values
+                else _measured_radius(model, left))
+    return Drive(DIFF_DRIVE, block.path, cfg.left_joints, cfg.right_joints, cfg.wheel_separation, sep_from,
+                 cfg.wheel_radius, rad_from)
+
+
+def _skid_steer(model, values, path):
+    cfg = cfgmod.skid_steer_config(model, values, path)
+    sep_from = "<wheelSeparation> tag" if "wheelSeparation" in values else "plugin default"
+    rad_from = "<wheelDiameter> tag / 2" if "wheelDiameter" in values else "plugin default"
+    return Drive(SKID_STEER, path, cfg.left_joints, cfg.right_joints, cfg.wheel_separation, sep_from,
+                 cfg.wheel_radius, rad_from)
+
+
+def _kobuki(values, path):
+    """The Kobuki plugin requires its geometry tags (the simulator refuses it without them)."""
+    def number(tag):
+        try:
+            return float(values[tag])
+        except (KeyError, ValueError):
+            return None
+
+    diameter = number("wheel_diameter")
+    return Drive(KOBUKI, path, [values.get("left_wheel_joint_name", "?")],
+                 [values.get("right_wheel_joint_name", "?")], number("wheel_separation"), "<wheel_separation> tag",
+                 diameter / 2.0 if diameter is not None else None, "<wheel_diameter> tag / 2")
+
+
+def _ddc(model, name, params, file):
+    """A DiffDriveController: its drive and the warnings bullet_sim logs for it."""
+    cfg = ddc.ddc_config(params, name)
+    notes = list(cfg.warnings)
+    if cfg.unknown_keys:
+        notes.append(f"{name}: parameters DiffDriveController does not read, ignored: {', '.join(cfg.unknown_keys)}")
+    for joint in cfg.joints:
+        model.joint(joint, name)
+    left, right = cfg.left_wheels[0], cfg.right_wheels[0]
+    if cfg.wheel_separation is None:
+        separation = model.wheel_separation(left, right, name)
+        sep_from = _measured_separation(left, right)
+    else:
+        separation, sep_from = cfg.wheel_separation, f"{name}/wheel_separation in {file}"
+    if cfg.wheel_radius is None:
+        radius = model.wheel_radius(left, name)
+        rad_from = _measured_radius(model, left)
+    else:
+        radius, rad_from = cfg.wheel_radius, f"{name}/wheel_radius in {file}"
+    if cfg.wheel_separation_multiplier != 1.0:
+        sep_from += f", x wheel_separation_multiplier {cfg.wheel_separation_multiplier:g}"
+        separation *= cfg.wheel_separation_multiplier
+    if cfg.left_wheel_radius_multiplier != 1.0:
+        rad_from += f", x left_wheel_radius_multiplier {cfg.left_wheel_radius_multiplier:g}"
+        radius *= cfg.left_wheel_radius_multiplier
+    return Drive(ddc.CONTROLLER_TYPE, f"{name} from {file}", list(cfg.left_wheels), list(cfg.right_wheels),
+                 separation, sep_from, radius, rad_from), notes
+
+
+# ------------------------------------------------------------------------------------------ formatting
+
+#: At most this many warning lines are printed (the rest counted), so the report stays one screen.
+MAX_WARNINGS = 10
+
+
+def format_report(report, extra_warnings=()):
+    """The report as lines (no trailing newlines). ``extra_warnings``: what bullet_sim logged beyond the
+    report's own (merged, duplicates dropped)."""
+    lines = [f"model: {report.source} (robot '{report.name}')"]
+    mass_ok = abs(report.loaded_mass - report.urdf_mass) <= MASS_TOLERANCE
+    lines.append(f"mass: URDF {report.urdf_mass:.4f} kg, loaded in PyBullet {report.loaded_mass:.4f} kg"
+                 + ("" if mass_ok else f"  (differs by {report.loaded_mass - report.urdf_mass:+.4f} kg)"))
+    if not report.drives:
+        lines.append("drive: none found (no diff-drive, skid-steer, kobuki or planar-move plugin, and no "
+                     "DiffDriveController under libgazebo_ros_control.so)")
+    for index, drive in enumerate(report.drives):
+        label = "drive" if index == 0 else "also a drive (not used by robot_check)"
+        lines.append(f"{label}: {drive.kind} at {drive.where}")
+        if drive.note:
+            lines.append(f"  {drive.note}")
+            continue
+        lines.append(f"  wheels: left {', '.join(drive.left)}; right {', '.join(drive.right)}")
+        lines.append(f"  separation {_m(drive.separation)} ({drive.separation_from})")
+        lines.append(f"  radius {_m(drive.radius)} ({drive.radius_from})")
+    lines.append("plugins, sensors and controllers:")
+    if not report.items:
+        lines.append("  (none)")
+    for item in report.items:
+        mark = "simulated    " if item.simulated else "NOT simulated"
+        what = item.what if item.kind != "sensor" else f"type {item.what}"
+        lines.append(f"  {mark}  {item.kind} {item.name} ({what}) {item.where}")
+    warnings = _unique(list(report.warnings) + list(extra_warnings))
+    lines.append(f"warnings bullet_sim logs at start: {len(warnings) or 'none'}")
+    for text in warnings[:MAX_WARNINGS]:
+        lines.append(f"  {text}")
+    if len(warnings) > MAX_WARNINGS:
+        lines.append(f"  ... and {len(warnings) - MAX_WARNINGS} more")
+    return lines
+
+
+def _m(value):
+    return "?" if value is None or not math.isfinite(value) else f"{value:.4g} m"
+
+
+def format_motions(straight, turn):
+    """Lines for the two judged motions (:mod:`diffbot_sim.drive_check` results); ``straight``/``turn`` may be
+    None when the motion could not be run."""
+    lines = []
+    if straight is not None:
+        lines.append(f"straight 0.2 m/s x 4 s: odometry {straight.odom_distance:.3f} m, ground truth "
+                     f"{straight.truth_distance:.3f} m (command {straight.expected:.1f} m); heading change "
+                     f"{straight.odom_heading:.3f} / {straight.truth_heading:.3f} rad: "
+                     f"{'PASS' if straight.passed else 'FAIL'}")
+        lines.extend(f"  {text}" for text in straight.failures)
+    if turn is not None:
+        lines.append(f"turn 0.5 rad/s x 4 s: odometry {turn.odom_yaw:.3f} rad, ground truth {turn.truth_yaw:.3f} rad "
+                     f"(command {turn.expected:.1f} rad), moved {turn.moved:.3f} m: {'PASS' if turn.passed else 'FAIL'}")
+        lines.extend(f"  {text}" for text in turn.failures)
+    return lines
+
