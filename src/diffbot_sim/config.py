@@ -87,12 +87,13 @@ SKID_STEER_DEFAULTS = {"left_front": "left_front_joint", "left_rear": "left_rear
                        "covariance_x": 1e-4, "covariance_y": 1e-4, "covariance_yaw": 0.01}
 
 
-def skid_steer_config(model, values, path):
+def skid_steer_config(model, values, path, notes=None):
     """DriveConfig of a gazebo_ros_skid_steer_drive block: ``values`` maps its tags to their texts.
 
     Raises:
         ConfigError, ModelError: as :func:`drive_config`.
     """
+    notes = notes if notes is not None else []
     merged = dict(SKID_STEER_DEFAULTS)
     for tag, text in values.items():
         if tag in SKID_STEER_TAGS:
@@ -102,7 +103,7 @@ def skid_steer_config(model, values, path):
         label = f"<{key}> of {path}"
         if key in ("left_front", "left_rear", "right_front", "right_rear"):
             continue
-        setattr(cfg, key, _drive_value(key, value, label))
+        setattr(cfg, key, _drive_value(key, value, label, notes))
     cfg.left_joints = [_string(f"<leftFrontJoint> of {path}", merged["left_front"]),
                        _string(f"<leftRearJoint> of {path}", merged["left_rear"])]
     cfg.right_joints = [_string(f"<rightFrontJoint> of {path}", merged["right_front"]),
@@ -172,7 +173,7 @@ def sim_config(params):
     return cfg
 
 
-def drive_config(model, block, params):
+def drive_config(model, block, params, notes=None):
     """Merge defaults, the diff-drive plugin block (may be None) and private params into a DriveConfig.
 
     Wheel separation and diameter missing from both are taken from the URDF. Returns None when neither the
@@ -181,7 +182,10 @@ def drive_config(model, block, params):
     Raises:
         ConfigError: a value of the wrong type or range. ModelError: a wheel joint the model lacks, a drive
             wheel whose transmission is not a velocity interface, a wheel without a usable radius.
+
+    Values Gazebo tolerates with a warning (``odometrySource ENCODER``) append it to ``notes`` when given.
     """
+    notes = notes if notes is not None else []
     given = {k: v for k, v in params.items() if k in {f.name for f in fields(DriveConfig)}}
     if block is None and "left_joints" not in given:
         return None
@@ -195,7 +199,7 @@ def drive_config(model, block, params):
     sources.append((given, lambda k: f"~{k}"))
     for values, label in sources:
         for key, value in values.items():
-            setattr(cfg, key, _drive_value(key, value, label(key)))
+            setattr(cfg, key, _drive_value(key, value, label(key), notes))
     if block is not None and block.dialect == "ros1" and "publish_odom_tf" not in given \
             and block.values.get("publish_odom") is not None and not cfg.publish_odom:
         cfg.publish_odom_tf = False  # ROS 1 publishTf=false removes the odom topic and its TF together
@@ -348,18 +352,11 @@ def as_params(cfg):
 
 # -------------------------------------------------------------------------------------------- validators
 
-#: Warnings of values Gazebo tolerates (taken and cleared by the caller that logs them: ``take_notes``).
-NOTES = []
 
 
-def take_notes():
-    """The tolerated-value warnings gathered since the last call."""
-    notes = list(NOTES)
-    NOTES.clear()
-    return notes
-
-
-def _drive_value(key, value, label):
+def _drive_value(key, value, label, notes):
+    """``value`` of DriveConfig field ``key``, validated; a value Gazebo tolerates with a warning appends
+    that warning to ``notes``."""
     if key in ("left_joints", "right_joints"):
         names = [value] if isinstance(value, str) else value
         if not isinstance(names, (list, tuple)) or not all(isinstance(n, str) and n for n in names):
@@ -382,7 +379,7 @@ def _drive_value(key, value, label):
         if mapped is None:
             # gazebo_ros_diff_drive compares with "encoder" and "world" exactly; anything else (a published
             # model writes ENCODER) gets a warning and the world pose.
-            NOTES.append(f"{label}: '{value}' is neither 'encoder' nor 'world' (Gazebo matches them exactly); "
+            notes.append(f"{label}: '{value}' is neither 'encoder' nor 'world' (Gazebo matches them exactly); "
                          "using world, as Gazebo does")
             return "world"
         return mapped

@@ -351,10 +351,8 @@ def test_wheel_efforts_capped_by_urdf_limit():
 @pytest.mark.parametrize("text", ["ENCODER", "2", "ground_truth"])
 def test_unmatched_odometry_source_warns_and_uses_world(parse, make_urdf, text):
     """gazebo_ros_diff_drive matches 'encoder' and 'world' exactly; anything else warns and uses world."""
-    from diffbot_sim.config import take_notes
-
-    take_notes()
-    cfg = _drive(parse, make_urdf, _ros1(f"<odometrySource>{text}</odometrySource>"))
+    model = parse(make_urdf(gazebo=_gazebo(_ros1(f"<odometrySource>{text}</odometrySource>"))))
+    notes = []
+    cfg = drive_config(model, read_plugins(model).diff_drive, {}, notes)
     assert cfg.odometry_source == "world"
-    notes = take_notes()
     assert len(notes) == 1 and "<odometrySource>" in notes[0] and text in notes[0]

@@ -152,8 +152,7 @@ class DiffDrive(Plugin):
 
 def create(ctx, block, params):
     """The model's diff drive (``block`` may be None when ``~left_joints`` describes one), or None."""
-    drive = cfgmod.drive_config(ctx.model, block, params)
-    ctx.warnings.extend(cfgmod.take_notes())
+    drive = cfgmod.drive_config(ctx.model, block, params, ctx.warnings)
     if drive is None:
         return None
     where = block.path if block is not None else "private parameters"

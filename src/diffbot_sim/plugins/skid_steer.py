@@ -19,7 +19,7 @@ class SkidSteerDrive(DiffDrive):
 
 def create(ctx, element, path, params):
     values = {child.tag: tag_value(child) for child in element}
-    drive = cfgmod.skid_steer_config(ctx.model, values, path)
+    drive = cfgmod.skid_steer_config(ctx.model, values, path, ctx.warnings)
     drive.namespace = ctx.plugin_namespace(drive.namespace)
     drive.odometry_frame = ctx.frame(ctx.clean_frame(drive.odometry_frame, path))
     drive.robot_base_frame = ctx.frame(ctx.clean_frame(drive.robot_base_frame, path))
