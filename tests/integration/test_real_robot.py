@@ -8,7 +8,8 @@ turns its body slower than its wheels say (its wheels slide sideways; real YAMLs
 wheel_separation_multiplier for it), so in the turn its ground truth need only turn the right way by a
 quarter of the command and stay within 0.2 m, while its own odometry must still read the commanded turn;
 ~odom_is_truth (bool, default false): the drive's odometry is the world pose (gazebo_ros_skid_steer_drive),
-so in the turn it is held to the ground truth's bounds. Callbacks only record; waits poll with deadlines; times are sim time.
+so in the turn it is held to the ground truth's bounds; ~holonomic (bool, default false): also 0.2 m/s
+sideways (linear.y) for 4 s: 0.8 m to the robot's left, heading kept. Callbacks only record; waits poll with deadlines; times are sim time.
 """
 import math
 import sys
@@ -67,12 +68,12 @@ class RealRobotTest(unittest.TestCase):
                 self.fail(f"timed out after {timeout} s waiting for {what}")
             time.sleep(0.005)
 
-    def drive(self, linear, angular, seconds):
+    def drive(self, linear, angular, seconds, lateral=0.0):
         """Command (linear, angular) at 20 Hz of sim time for ``seconds``; returns (odom, truth) at start and end."""
         start = (self.odom.get(), self.truth.get())
         end_time = rospy.get_time() + seconds
         msg = Twist()
-        msg.linear.x, msg.angular.z = linear, angular
+        msg.linear.x, msg.linear.y, msg.angular.z = linear, lateral, angular
         while rospy.get_time() < end_time:
             self.pub.publish(msg)
             rospy.sleep(0.05)
@@ -106,6 +107,18 @@ class RealRobotTest(unittest.TestCase):
             self.assertGreater(distance, 0.85 * SPEED * SECONDS, f"{name}: drove {distance:.3f} m")
             self.assertLess(distance, 1.15 * SPEED * SECONDS, f"{name}: drove {distance:.3f} m")
             self.assertLess(heading, 0.1, f"{name}: heading changed {heading:.3f} rad")
+
+        if rospy.get_param("~holonomic", False):
+            (o0, t0), (o1, t1) = self.drive(0.0, 0.0, SECONDS, lateral=SPEED)
+            self.stop()
+            for name, a, b in (("odometry", o0, o1), ("ground truth", t0, t1)):
+                p0, p1, yaw = a.pose.pose.position, b.pose.pose.position, yaw_of(a)
+                dx, dy = p1.x - p0.x, p1.y - p0.y
+                left = -math.sin(yaw) * dx + math.cos(yaw) * dy  # along the robot's +y (REP 103: left)
+                rospy.loginfo(f"FIGURE sideways[{name}]: {left:.3f} m to the left")
+                self.assertGreater(left, 0.85 * SPEED * SECONDS, f"{name}: moved {left:.3f} m left")
+                self.assertLess(left, 1.15 * SPEED * SECONDS, f"{name}: moved {left:.3f} m left")
+                self.assertLess(abs(wrap(yaw_of(b) - yaw)), 0.1, f"{name}: heading changed")
 
         (o0, t0), (o1, t1) = self.drive(0.0, TURN, SECONDS)
         self.stop()
