@@ -54,6 +54,11 @@ JOINT_COMMAND_TYPES = {"velocity_controllers/JointVelocityController": "Velocity
                        "effort_controllers/JointEffortController": "EffortJointInterface"}
 
 
+def loop_gain(p, dt, inertia):
+    """p·dt/inertia: how far one step of an explicit velocity P loop overshoots (stable below 2)."""
+    return p * dt / max(inertia, 1e-12)
+
+
 class Pid:
     """A PID on velocity error (control_toolbox semantics: i_clamp bounds the integral term)."""
 
@@ -125,7 +130,7 @@ class RosControl(Plugin):
             if joint not in self.index:
                 continue
             inertia = self.ctx.robot.smallest_inertia(self.index[joint])
-            gain = self.pids[joint].p * dt / max(inertia, 1e-12)
+            gain = loop_gain(self.pids[joint].p, dt, inertia)
             if gain > STABLE_LOOP_GAIN:
                 self.ctx.warnings.append(
                     f"{join(ns, 'gazebo_ros_control/pid_gains')}/{joint}: p={self.pids[joint].p:g} at a "
