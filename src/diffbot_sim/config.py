@@ -99,8 +99,9 @@ def skid_steer_config(model, values, path, notes=None):
         if tag in SKID_STEER_TAGS:
             merged[SKID_STEER_TAGS[tag]] = text
     cfg = DriveConfig(odometry_source="world")
+    tag_of = {key: tag for tag, key in SKID_STEER_TAGS.items()}
     for key, value in merged.items():
-        label = f"<{key}> of {path}"
+        label = f"<{tag_of.get(key, key)}> of {path}"
         if key in ("left_front", "left_rear", "right_front", "right_rear"):
             continue
         setattr(cfg, key, _drive_value(key, value, label, notes))
