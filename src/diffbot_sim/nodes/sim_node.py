@@ -1,19 +1,18 @@
 """``bullet_sim``: the PyBullet simulator node (the thin ROS shell around the pure modules).
 
-Loads a URDF/xacro robot into PyBullet, turns its transmissions into joint motors, runs the model's
-gazebo_ros_diff_drive plugin on ``cmd_vel`` and publishes what gazebo_ros would. One thread owns PyBullet:
-subscriber and service callbacks only hand data to the loop.
+Loads URDF/xacro robots into PyBullet (fixed links lumped as Gazebo lumps them, meshes converted), gives
+each of their ``<gazebo>`` plugins to the module that simulates it (:mod:`diffbot_sim.plugins.registry`:
+diff drive, skid steer, planar move, Kobuki, gazebo_ros_control with the controllers found on the parameter
+server, joint-state publisher) and publishes what gazebo_ros would. One thread owns PyBullet: subscriber and
+service callbacks only hand data to the loop, which asks every plugin what is due and knows none by name.
 
-Topics (names as the model's plugins set them; defaults shown, relative to the namespace):
-    cmd_vel (geometry_msgs/Twist, in): body velocity command; linear.x and angular.z are used.
-    odom (nav_msgs/Odometry): pose in ``odom``, twist in ``base_footprint``, at the drive's update rate.
-    /tf (tf2_msgs/TFMessage): odom -> base_footprint, when publish_odom_tf.
-    joint_states (sensor_msgs/JointState): the joint-state plugin's joints (+ wheels if asked).
+Topics: each plugin's (its module docstring; resolved names are written to ``~cmd_vel_topic``,
+``~odom_topic`` and the other start-up summary parameters), plus:
     /clock (rosgraph_msgs/Clock): sim time, at ~clock_rate.
-    <joint>_velocity_controller/command etc. (std_msgs/Float64, in): joints whose transmission is not
-        a drive wheel, named as gazebo_ros_control + ros_controllers would name them.
-    ~debug/cmd_applied (geometry_msgs/TwistStamped): when ~debug_cmd_applied, the wall time a command
-        reached the motors (for latency measurement).
+    /tf (tf2_msgs/TFMessage): every plugin's transforms of a step, in one message.
+    ~ground_truth (nav_msgs/Odometry): when ~publish_ground_truth.
+    ~debug/cmd_applied (geometry_msgs/TwistStamped): when ~debug_cmd_applied, the wall time a diff-drive
+        command reached the motors (for latency measurement).
 Services: ~pause_physics, ~unpause_physics, ~reset_simulation (std_srvs/Empty).
 Parameters: see diffbot_sim.config.SimConfig and DriveConfig (README table).
 """
