@@ -60,6 +60,7 @@ class World:
         self.gravity = gravity
         self._files = []
         self.robots = []
+        self.world_bodies = []  # (PyBullet id, world.Body)
         self._setup()
 
     def _setup(self):
@@ -96,13 +97,123 @@ class World:
         self.robots.append(robot)
         return robot
 
+    def load_world(self, world, mesh_cache):
+        """Build a :class:`diffbot_sim.world.WorldDescription`: one PyBullet body per world body.
+
+        Static bodies get mass 0; their meshes collide as the triangles they are (a hollow ring stays
+        hollow), dynamic ones as convex hulls (what Bullet can simulate). Mesh files are converted and cached
+        as for robots (COLLADA units honoured). The world's own ground plane replaces ours. World surfaces
+        combine with a robot's by multiplication in Bullet where ODE takes the lower one; so a world friction
+        is capped at 1 (Gazebo's ground plane says 100), which makes the product the lower of the two
+        whenever either is 1 or more.
+
+        Returns:
+            the number of bodies built. Dynamic bodies go back to their start on ``reset``.
+
+        Raises:
+            ModelError: a mesh that cannot be read (its file named).
+        """
+        if world.has_ground and self.plane is not None:
+            pybullet.removeBody(self.plane, physicsClientId=self.client)
+            self.plane = None
+        built = 0
+        for body in world.bodies:
+            shapes = [s for s in body.shapes if s.kind != "plane" or body.static]
+            if not shapes:
+                continue
+            c = self.client
+            index = self._compound(shapes, body.static, mesh_cache)
+            mass = 0.0 if body.static else max(body.mass, 1e-6)
+            (px, py, pz), orientation = body.pose
+            com, com_orn = body.inertial_pose
+            uid = pybullet.createMultiBody(baseMass=mass, baseCollisionShapeIndex=index, basePosition=(0, 0, 0),
+                                           baseInertialFramePosition=com, baseInertialFrameOrientation=com_orn,
+                                           physicsClientId=c)
+            # createMultiBody takes the inertial frame's pose as the base pose: place the link frame instead.
+            self._place(uid, body.pose, body.inertial_pose)
+            options = {}
+            mus = [body.shapes[0].surface[k] for k in ("mu", "mu2") if k in body.shapes[0].surface]
+            options["lateralFriction"] = min(min(mus), 1.0) if mus else 1.0
+            if not body.static:
+                ixx, iyy, izz = body.inertia[:3]
+                options["localInertiaDiagonal"] = (ixx, iyy, izz)
+            pybullet.changeDynamics(uid, -1, physicsClientId=c, **options)
+            self.world_bodies.append((uid, body))
+            built += 1
+        return built
+
+    def _compound(self, shapes, static, mesh_cache):
+        """One collision shape index for a body's shapes (a compound when there are several)."""
+        from . import meshes  # pure; here only to convert world meshes
+
+        c = self.client
+        concave = pybullet.GEOM_FORCE_CONCAVE_TRIMESH if static else 0
+        if len(shapes) == 1 and shapes[0].kind == "trimesh":
+            shape = shapes[0]
+            return pybullet.createCollisionShape(
+                pybullet.GEOM_MESH, vertices=shape.vertices.tolist(), indices=shape.indices.ravel().tolist(),
+                flags=pybullet.GEOM_FORCE_CONCAVE_TRIMESH, collisionFramePosition=shape.pose[0],
+                collisionFrameOrientation=shape.pose[1], physicsClientId=c)
+        kinds, radii, halves, lengths, files, scales, normals, flags, positions, orientations = \
+            [], [], [], [], [], [], [], [], [], []
+        for shape in shapes:
+            kind = {"box": pybullet.GEOM_BOX, "cylinder": pybullet.GEOM_CYLINDER, "sphere": pybullet.GEOM_SPHERE,
+                    "plane": pybullet.GEOM_PLANE, "mesh": pybullet.GEOM_MESH}.get(shape.kind)
+            if kind is None:
+                continue  # the reader named it already
+            kinds.append(kind)
+            size = tuple(shape.size) + (0.0, 0.0, 0.0)
+            radii.append(size[0] if shape.kind in ("cylinder", "sphere") else 0.0)
+            lengths.append(size[1] if shape.kind == "cylinder" else 0.0)
+            halves.append(tuple(v / 2.0 for v in size[:3]) if shape.kind == "box" else (0.0, 0.0, 0.0))
+            normals.append(size[:3] if shape.kind == "plane" else (0.0, 0.0, 1.0))
+            files.append(meshes.convert_cached(shape.mesh, mesh_cache) if shape.kind == "mesh" else "")
+            scales.append(tuple(shape.scale) if shape.kind == "mesh" else (1.0, 1.0, 1.0))
+            flags.append(concave if shape.kind == "mesh" else 0)
+            positions.append(shape.pose[0])
+            orientations.append(shape.pose[1])
+        if len(kinds) == 1:
+            return pybullet.createCollisionShape(
+                kinds[0], radius=radii[0], halfExtents=halves[0], height=lengths[0], fileName=files[0],
+                meshScale=scales[0], planeNormal=normals[0], flags=flags[0],
+                collisionFramePosition=positions[0], collisionFrameOrientation=orientations[0],
+                physicsClientId=c)
+        return pybullet.createCollisionShapeArray(
+            kinds, radii=radii, halfExtents=halves, lengths=lengths, fileNames=files, meshScales=scales,
+            planeNormals=normals, flags=flags, collisionFramePositions=positions,
+            collisionFrameOrientations=orientations, physicsClientId=c)
+
+    def _place(self, uid, pose, inertial_pose):
+        """Put body ``uid``'s link frame at ``pose`` (PyBullet places the inertial frame)."""
+        com = pybullet.multiplyTransforms(pose[0], pose[1], inertial_pose[0], inertial_pose[1])
+        pybullet.resetBasePositionAndOrientation(uid, com[0], com[1], physicsClientId=self.client)
+        pybullet.resetBaseVelocity(uid, (0, 0, 0), (0, 0, 0), physicsClientId=self.client)
+
+    def body_pose(self, uid, inertial_pose):
+        """Link-frame pose of world body ``uid`` (whose inertial frame sits at ``inertial_pose``)."""
+        com = pybullet.getBasePositionAndOrientation(uid, physicsClientId=self.client)
+        inv = pybullet.invertTransform(inertial_pose[0], inertial_pose[1])
+        return pybullet.multiplyTransforms(com[0], com[1], inv[0], inv[1])
+
+    def top_at(self, x, y, ignore=()):
+        """Height [m] of the highest world surface at (x, y) (a ray from 100 m down), 0 when none."""
+        hits = pybullet.rayTestBatch([(x, y, 100.0)], [(x, y, -100.0)], physicsClientId=self.client)
+        top = 0.0
+        for hit in hits:
+            if hit[0] >= 0 and hit[0] not in ignore:
+                top = max(top, hit[3][2])
+        return top
+
     def step(self):
         pybullet.stepSimulation(physicsClientId=self.client)
 
     def reset(self):
-        """Put every robot back at its spawn pose, at rest."""
+        """Put every robot back at its spawn pose and every dynamic world body at its start, at rest."""
         for robot in self.robots:
             robot.reset()
+        for uid, body in self.world_bodies:
+            if not body.static:
+                self._place(uid, body.pose, body.inertial_pose)
 
     def close(self):
         if self.client is not None and pybullet.isConnected(self.client):

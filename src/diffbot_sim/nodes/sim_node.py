@@ -178,6 +178,7 @@ class Simulator:
         self._tf_msg = ros_msgs.tf_message([])
         self._clock_msg = ros_msgs.clock(rospy.Time(0))
         self.owns_clock = False  # main() sets it when use_sim_time made rospy follow /clock
+        self.world_description = None  # the world file's, when ~world names one
         self.links = SubscriberLinks(self.publishers, cfg.send_timeout, 0.0 if cfg.real_time else cfg.fast_batch)
 
     def publishers(self):
@@ -237,6 +238,9 @@ class Simulator:
         rospy.Service("~pause_physics", Empty, lambda _req: self._request("pause"))
         rospy.Service("~unpause_physics", Empty, lambda _req: self._request("unpause"))
         rospy.Service("~reset_simulation", Empty, lambda _req: self._request("reset"))
+        # As Gazebo's reset_world: models and robots back to their start; sim time goes on (so does ours on
+        # reset_simulation, which also brakes every plugin).
+        rospy.Service("~reset_world", Empty, lambda _req: self._request("reset"))
 
     # -- the loop -----------------------------------------------------------------------------------
     def run(self):
@@ -353,7 +357,8 @@ def _build_robot(sim, cfg, spec, params):
     found = read_plugins(model, known=registry.KNOWN)
     for trans in model.transmissions:
         model.joint(trans.joint, f"/robot/transmission[@name='{trans.name}']")
-    robot = sim.world.load_robot(text, model, (spec.x, spec.y, spec.z), spec.yaw)
+    z = max(spec.z, sim.world.top_at(spec.x, spec.y)) if sim.world.world_bodies else spec.z
+    robot = sim.world.load_robot(text, model, (spec.x, spec.y, z), spec.yaw)
     namespace = "/" + spec.name if spec.name else None
     ctx = RobotContext(sim, cfg, spec, model, robot, params, namespace, f"~{spec.name}/" if spec.name else "~")
     runtime = RobotRuntime(ctx, registry.build(ctx, found, params))
@@ -371,12 +376,46 @@ def _package_path(package):
         raise LookupError(package) from err
 
 
+def _read_world(cfg):
+    """The world file's description (SDF .world, or a map_server .yaml), or None without ``~world``."""
+    if not cfg.world:
+        return None
+    path = os.path.abspath(os.path.expanduser(cfg.world))
+    if not os.path.isfile(path):
+        raise ModelError("no such world file", path)
+    if path.endswith((".yaml", ".yml")):
+        from ..world_map import read_map
+        return read_map(path, cfg.map_wall_height)
+    from ..world_sdf import read_world, ros_package_model_paths
+    return read_world(path, package_model_paths=ros_package_model_paths())
+
+
+def _apply_world_physics(cfg, world, params):
+    """A world's gravity and real_time_factor apply unless the node's parameters set them; its step does
+    not (ours is the measured one; ``~time_step`` chooses another)."""
+    if "gravity" not in params and world.gravity is not None:
+        cfg.gravity = world.gravity[2]
+        if abs(world.gravity[0]) > 1e-9 or abs(world.gravity[1]) > 1e-9:
+            world.not_simulated.append(f"horizontal gravity {world.gravity[:2]} (only its z is simulated)")
+    if "real_time_factor" not in params and world.real_time_factor:
+        cfg.real_time_factor = world.real_time_factor
+    if world.max_step_size:
+        world.not_simulated.append(f"physics max_step_size {world.max_step_size:g} s (the step is ~time_step, "
+                                   f"{cfg.time_step:g} s)")
+
+
 def build(cfg, params):
     """Build the simulator with every robot of ``~robots`` (or the one robot); raises DiffbotSimError on
     bad input, naming the robot's file, element or parameter."""
     specs = cfgmod.robot_specs(cfg, params)
+    world = _read_world(cfg)
+    if world is not None:
+        _apply_world_physics(cfg, world, params)
     sim = Simulator(cfg)
     try:
+        if world is not None:
+            sim.world_description = world
+            sim.world.load_world(world, meshes.default_cache_dir())
         loaded = [_build_robot(sim, cfg, spec, params) for spec in specs]
     except BaseException:
         sim.close()
@@ -384,10 +423,18 @@ def build(cfg, params):
     return sim, loaded
 
 
-def _report(cfg, loaded):
+def _report(cfg, loaded, world=None):
     """Log the effective configuration once and write it back to the private parameters."""
     for key, value in cfgmod.as_params(cfg).items():
         rospy.set_param("~" + key, value)
+    if world is not None:
+        for text in world.warnings:
+            rospy.logwarn(f"world {world.source}: {text}")
+        if world.not_simulated:
+            rospy.logwarn(f"world {world.source}: not simulated (accepted): " + "; ".join(world.not_simulated))
+        rospy.set_param("~world_bodies", len(world.bodies))
+        rospy.loginfo(f"bullet_sim: world {world.source} ({world.name}): {len(world.bodies)} bodies, "
+                      f"{sum(1 for b in world.bodies if not b.static)} dynamic")
     for item in loaded:
         found, model, runtime = item.plugins, item.model, item.runtime
         who = f"robot {item.spec.name}: " if item.spec.name else ""
@@ -457,7 +504,7 @@ def _main():
         rospy.signal_shutdown("bad input")
         return 1
     try:
-        _report(cfg, loaded)
+        _report(cfg, loaded, sim.world_description)
         sim.advertise_services()
         sim.run()
     finally:

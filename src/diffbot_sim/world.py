@@ -1,0 +1,74 @@
+"""A world as plain data (pure): what the SDF reader (:mod:`diffbot_sim.world_sdf`) and the map-image
+converter (:mod:`diffbot_sim.world_map`) produce and the physics layer builds.
+
+Every pose is ``(xyz, quaternion xyzw)`` with plain float tuples. A body is one SDF ``<link>`` (a model with
+several links gives several bodies; joints between them are not simulated and are named in ``warnings``).
+Mesh shapes carry the mesh file's absolute path and its scale; the physics layer converts and caches them
+(:mod:`diffbot_sim.meshes`), so COLLADA units are honoured as for robots.
+"""
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Tuple
+
+Vec3 = Tuple[float, float, float]
+Quat = Tuple[float, float, float, float]
+Pose = Tuple[Vec3, Quat]
+IDENTITY: Pose = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+
+
+@dataclass
+class Shape:
+    """One collision shape, posed in its body's link frame.
+
+    ``kind``: ``box`` (``size`` = x, y, z), ``cylinder`` (radius, length; axis z), ``sphere`` (radius,),
+    ``plane`` (normal x, y, z; infinite, as Gazebo's plane collision), ``mesh`` (``mesh`` = absolute file
+    path, ``scale``), or ``trimesh`` (``vertices``/``indices`` given in place: a map image's walls).
+    ``surface``: Gazebo surface values that apply (``mu``, ``mu2``, ``kp``, ``kd``, ``laser_retro``...).
+    """
+
+    kind: str
+    size: Tuple[float, ...] = ()
+    pose: Pose = IDENTITY
+    mesh: Optional[str] = None
+    scale: Vec3 = (1.0, 1.0, 1.0)
+    vertices: Optional[object] = None  # numpy (N, 3) float for kind trimesh
+    indices: Optional[object] = None  # numpy (M, 3) int for kind trimesh
+    surface: Dict[str, float] = field(default_factory=dict)
+    name: str = ""
+
+
+@dataclass
+class Body:
+    """One rigid body of the world: an SDF link (``model::link``), static or dynamic.
+
+    ``mass`` kg and ``inertia`` (ixx, iyy, izz, ixy, ixz, iyz) about the centre of mass, whose pose in the
+    link frame is ``inertial_pose`` (SDF's default inertial where the file gives none: mass 1, unit inertia).
+    """
+
+    name: str
+    model: str
+    pose: Pose
+    static: bool
+    shapes: List[Shape] = field(default_factory=list)
+    mass: float = 1.0
+    inertia: Tuple[float, float, float, float, float, float] = (1.0, 1.0, 1.0, 0.0, 0.0, 0.0)
+    inertial_pose: Pose = IDENTITY
+
+
+@dataclass
+class WorldDescription:
+    """Everything a world file asks of the simulator.
+
+    ``gravity`` m/s^2 (vector); ``real_time_factor`` and ``max_step_size`` from ``<physics>`` (None when the
+    file gives none); ``not_simulated``: lights, scene, GUI camera, plugins, other ``<physics>`` settings,
+    named once at start; ``warnings``: one line each (unknown geometry skipped, missing mesh skipped...).
+    """
+
+    name: str
+    source: str
+    bodies: List[Body] = field(default_factory=list)
+    gravity: Vec3 = (0.0, 0.0, -9.8)
+    real_time_factor: Optional[float] = None
+    max_step_size: Optional[float] = None
+    not_simulated: List[str] = field(default_factory=list)
+    warnings: List[str] = field(default_factory=list)
+    has_ground: bool = False  # a ground plane is among the bodies (else the simulator adds its own)
