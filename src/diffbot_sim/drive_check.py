@@ -79,17 +79,18 @@ def straight(odom_start, odom_end, truth_start, truth_end, expected=SPEED * SECO
 
 
 def turn(odom_start, odom_end, truth_start, truth_end, expected=TURN * SECONDS, truth_fraction=None,
-         max_moved=None):
+         max_moved=None, odom_fraction=1.0 - TURN_TOLERANCE):
     """Judge the turn in place: the odometry's yaw change within TURN_TOLERANCE of ``expected``.
 
     The ground truth is always measured; it is judged only when asked: ``truth_fraction`` (the body must turn
     the commanded way by at least this fraction of ``expected``) and ``max_moved`` (m). A four-wheel robot
     driven as a diff drive turns its body slower than its wheels say (its wheels slide sideways), which its
-    own odometry does not see, so callers choose how much of that they tolerate.
+    own odometry does not see, so callers choose how much of that they tolerate; an odometry that *is* the
+    world pose (gazebo_ros_skid_steer_drive) sees the slide, hence ``odom_fraction`` (the lower bound).
     """
     result = Turn(expected, wrap(odom_end[2] - odom_start[2]), wrap(truth_end[2] - truth_start[2]),
                   _distance(truth_start, truth_end))
-    low, high = (1.0 - TURN_TOLERANCE) * expected, (1.0 + TURN_TOLERANCE) * expected
+    low, high = odom_fraction * expected, (1.0 + TURN_TOLERANCE) * expected
     if not low < result.odom_yaw < high:
         result.failures.append(f"odometry: turned {result.odom_yaw:.3f} rad, expected {low:.2f}..{high:.2f} rad")
     if truth_fraction is not None and not result.truth_yaw > truth_fraction * expected:

@@ -165,11 +165,10 @@ def build_report(path, model_args="", controller_files=(), known=None, resolve_p
             origin[ns] = os.path.basename(name)
 
     warnings = list(found.warnings)
-    cfgmod.take_notes()  # start clean: the notes are a module-global list
     drives, items = [], []
     block = found.diff_drive
     if block is not None:
-        drives.append(_diff_drive(model, block))
+        drives.append(_diff_drive(model, block, warnings))
         items.append(Item("plugin", _name_of(block.path, DIFF_DRIVE), DIFF_DRIVE, block.path, True))
     if found.joint_state is not None:
         js = found.joint_state
@@ -180,7 +179,7 @@ def build_report(path, model_args="", controller_files=(), known=None, resolve_p
             continue
         values = {child.tag: tag_value(child) for child in other.element}
         if other.filename == SKID_STEER:
-            drives.append(_skid_steer(model, values, other.path))
+            drives.append(_skid_steer(model, values, other.path, warnings))
         elif other.filename == KOBUKI:
             drives.append(_kobuki(values, other.path))
         elif other.filename == PLANAR_MOVE:
@@ -212,7 +211,6 @@ def build_report(path, model_args="", controller_files=(), known=None, resolve_p
         for el in gazebo.element.iter("sensor"):
             name = el.get("name") or "?"
             items.append(Item("sensor", name, el.get("type") or "?", f"{gazebo.path}/sensor[@name='{name}']", False))
-    warnings.extend(cfgmod.take_notes())
     for blk in (found.diff_drive, found.joint_state):
         if blk is not None and blk.unknown_tags:
             warnings.append(f"{blk.path}: unknown tags ignored: {', '.join(blk.unknown_tags)}")
@@ -260,8 +258,8 @@ def _measured_separation(left, right):
     return f"measured: origins of {left} and {right}"
 
 
-def _diff_drive(model, block):
-    cfg = cfgmod.drive_config(model, block, {})
+def _diff_drive(model, block, notes):
+    cfg = cfgmod.drive_config(model, block, {}, notes)
     left, right = cfg.left_joints[0], cfg.right_joints[0]
     sep_from = (f"<{block.tag('wheel_separation')}> tag" if "wheel_separation" in block.values
                 else _measured_separation(left, right))
@@ -271,8 +269,8 @@ def _diff_drive(model, block):
                  cfg.wheel_radius, rad_from)
 
 
-def _skid_steer(model, values, path):
-    cfg = cfgmod.skid_steer_config(model, values, path)
+def _skid_steer(model, values, path, notes):
+    cfg = cfgmod.skid_steer_config(model, values, path, notes)
     sep_from = "<wheelSeparation> tag" if "wheelSeparation" in values else "plugin default"
     rad_from = "<wheelDiameter> tag / 2" if "wheelDiameter" in values else "plugin default"
     return Drive(SKID_STEER, path, cfg.left_joints, cfg.right_joints, cfg.wheel_separation, sep_from,
@@ -378,8 +376,9 @@ def format_motions(straight, turn):
                      f"{'PASS' if straight.passed else 'FAIL'}")
         lines.extend(f"  {text}" for text in straight.failures)
     if turn is not None:
-        lines.append(f"turn 0.5 rad/s x 4 s: odometry {turn.odom_yaw:.3f} rad, ground truth {turn.truth_yaw:.3f} rad "
-                     f"(command {turn.expected:.1f} rad), moved {turn.moved:.3f} m: {'PASS' if turn.passed else 'FAIL'}")
+        lines.append(f"turn 0.5 rad/s x 4 s: odometry {turn.odom_yaw:.3f} rad, ground truth {turn.truth_yaw:.3f} "
+                     f"rad (command {turn.expected:.1f} rad), moved {turn.moved:.3f} m: "
+                     f"{'PASS' if turn.passed else 'FAIL'}")
         lines.extend(f"  {text}" for text in turn.failures)
     return lines
 

@@ -10,6 +10,7 @@ quarter of the command and stay within 0.2 m, while its own odometry must still 
 ~odom_is_truth (bool, default false): the drive's odometry is the world pose (gazebo_ros_skid_steer_drive),
 so in the turn it is held to the ground truth's bounds; ~holonomic (bool, default false): also 0.2 m/s
 sideways (linear.y) for 4 s: 0.8 m to the robot's left, heading kept. Callbacks only record; waits poll with deadlines; times are sim time.
+The straight run and the turn are measured and judged by diffbot_sim.drive_check, shared with `robot_check`.
 """
 import math
 import sys
@@ -22,17 +23,21 @@ import rostest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
+from diffbot_sim import drive_check
+from diffbot_sim.drive_check import SECONDS, SPEED, TURN, wrap
+
 SIM = "/bullet_sim"
-SPEED, TURN, SECONDS = 0.2, 0.5, 4.0
 
 
 def yaw_of(msg):
     q = msg.pose.pose.orientation
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    return drive_check.yaw_from_quaternion(q.x, q.y, q.z, q.w)
 
 
-def wrap(a):
-    return math.atan2(math.sin(a), math.cos(a))
+def pose_of(msg):
+    """``(x, y, yaw)`` of an Odometry message, as drive_check takes poses."""
+    p = msg.pose.pose.position
+    return p.x, p.y, yaw_of(msg)
 
 
 class Latest:
@@ -99,14 +104,11 @@ class RealRobotTest(unittest.TestCase):
 
         (o0, t0), (o1, t1) = self.drive(SPEED, 0.0, SECONDS)
         self.stop()
-        for name, a, b in (("odometry", o0, o1), ("ground truth", t0, t1)):
-            p0, p1 = a.pose.pose.position, b.pose.pose.position
-            distance = math.hypot(p1.x - p0.x, p1.y - p0.y)
-            heading = abs(wrap(yaw_of(b) - yaw_of(a)))
+        straight = drive_check.straight(pose_of(o0), pose_of(o1), pose_of(t0), pose_of(t1))
+        for name, distance, heading in (("odometry", straight.odom_distance, straight.odom_heading),
+                                        ("ground truth", straight.truth_distance, straight.truth_heading)):
             rospy.loginfo(f"FIGURE straight[{name}]: {distance:.3f} m, heading change {heading:.3f} rad")
-            self.assertGreater(distance, 0.85 * SPEED * SECONDS, f"{name}: drove {distance:.3f} m")
-            self.assertLess(distance, 1.15 * SPEED * SECONDS, f"{name}: drove {distance:.3f} m")
-            self.assertLess(heading, 0.1, f"{name}: heading changed {heading:.3f} rad")
+        self.assertTrue(straight.passed, "; ".join(straight.failures))
 
         if rospy.get_param("~holonomic", False):
             (o0, t0), (o1, t1) = self.drive(0.0, 0.0, SECONDS, lateral=SPEED)
@@ -122,18 +124,13 @@ class RealRobotTest(unittest.TestCase):
 
         (o0, t0), (o1, t1) = self.drive(0.0, TURN, SECONDS)
         self.stop()
-        turned = wrap(yaw_of(o1) - yaw_of(o0))
-        truth_turned = wrap(yaw_of(t1) - yaw_of(t0))
-        p0, p1 = t0.pose.pose.position, t1.pose.pose.position
-        moved = math.hypot(p1.x - p0.x, p1.y - p0.y)
-        rospy.loginfo(f"FIGURE turn: odometry {turned:.3f} rad, truth {truth_turned:.3f} rad, moved {moved:.3f} m")
         skid = rospy.get_param("~skid", False)
-        low = 0.25 if skid and rospy.get_param("~odom_is_truth", False) else 0.8
-        self.assertGreater(turned, low * TURN * SECONDS, f"odometry turned {turned:.3f} rad")
-        self.assertLess(turned, 1.2 * TURN * SECONDS, f"odometry turned {turned:.3f} rad")
-        self.assertGreater(truth_turned, (0.25 if skid else 0.5) * TURN * SECONDS,
-                           f"the robot turned {truth_turned:.3f} rad")
-        self.assertLess(moved, 0.2 if skid else 0.1, f"turning in place moved the robot {moved:.3f} m")
+        low = 0.25 if skid and rospy.get_param("~odom_is_truth", False) else 1.0 - drive_check.TURN_TOLERANCE
+        turn = drive_check.turn(pose_of(o0), pose_of(o1), pose_of(t0), pose_of(t1), odom_fraction=low,
+                                truth_fraction=0.25 if skid else 0.5, max_moved=0.2 if skid else 0.1)
+        rospy.loginfo(f"FIGURE turn: odometry {turn.odom_yaw:.3f} rad, truth {turn.truth_yaw:.3f} rad, "
+                      f"moved {turn.moved:.3f} m")
+        self.assertTrue(turn.passed, "; ".join(turn.failures))
 
 
 if __name__ == "__main__":

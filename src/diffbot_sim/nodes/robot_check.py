@@ -3,14 +3,16 @@
 Someone moving a robot from Gazebo wants one screen that says whether it drives here, and if not, why. The
 static part (mass, drive and where its geometry came from, plugins, warnings) comes from
 :mod:`diffbot_sim.robot_report`, in this process. Then the robot is driven for real: a private master
-(``roscore -p <free port>``), the controller YAMLs loaded onto it, ``bullet_sim`` headless in fast mode
+(``roscore -p <free port>``), the controller YAMLs loaded onto it, ``bullet_sim`` headless at 3x real time
 with ground truth, and this process as a node publishing the commands and judging the motions with
 :mod:`diffbot_sim.drive_check` (the rules the fixture-robot rostests use).
 
-Fast mode, with ``~fast_batch`` 0: the batched writes of fast mode deliver ``/clock`` and odometry up to
-5 ms of wall time late, which at 40x real time is long enough for a DiffDriveController with
-``cmd_vel_timeout: 0.25`` to see its commands go stale (README "Fast mode is not lockstep"). Without
-batching each message goes out as it is made, and the 20 Hz (sim time) commands arrive in time.
+Paced at 3x real time, not fast mode (measured, 4 runs each on tests/data/robots/ros_control_4wd.urdf with
+its YAML, whose DiffDriveController has ``cmd_vel_timeout: 0.25``): in fast mode the tool's 20 Hz commands
+and its samples of odometry ride on ``/clock`` arriving in bursts, so the start and end of each motion are
+caught late by a varying number of sim steps: turn on odometry 1.82..2.05 rad with ``~fast_batch`` 0, and
+straight 0.70..0.78 m with the default 5 ms batches (0.68 m fails); at 3x real time, 1.966..1.975 rad and
+0.790..0.794 m, for about 3 s more wall time (7-8 s in all).
 
 Exit status: 0 when both motions pass, 1 when they do not (or the model or the simulator fails: one line
 naming the file, element or parameter), 2 on bad usage. Every process started is stopped, by its pid and
@@ -32,8 +34,8 @@ from ..errors import DiffbotSimError, ModelError
 USAGE = ("usage: rosrun diffbot_sim robot_check <model.urdf|model.urdf.xacro> [controller.yaml ...] "
          "[-- xacro args name:=value ...]")
 SIM = "/bullet_sim"
-#: Private parameters of bullet_sim for the check: headless, as fast as it can, no batching (see above).
-SIM_PARAMS = {"real_time": False, "fast_batch": 0.0, "publish_ground_truth": True, "gui": False}
+#: Private parameters of bullet_sim for the check: headless, 3x real time (see above), ground truth on.
+SIM_PARAMS = {"real_time": True, "real_time_factor": 3.0, "publish_ground_truth": True, "gui": False}
 MASTER_TIMEOUT = 20.0  # s (wall) for roscore to answer
 START_TIMEOUT = 60.0  # s (wall) for bullet_sim to load the model and report its settings
 TOPIC_TIMEOUT = 20.0  # s (wall) for the first odometry, ground truth and the command connection
@@ -117,13 +119,14 @@ def _main(argv):
     except SessionError as err:
         _say(f"result: FAIL: {err}")
         return 1
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as err:
         streams.write(sys.stderr, "robot_check: interrupted\n")
-        return 130
+        return 128 + (err.args[0] if err.args else signal.SIGINT)
 
 
 def _terminate(signum, frame):
-    raise KeyboardInterrupt
+    """SIGTERM ends the check as Ctrl-C does: the processes it started are stopped on the way out."""
+    raise KeyboardInterrupt(signum)
 
 
 def _load_yaml(path):
@@ -314,7 +317,7 @@ class Session:
         if self.sim is not None:
             self.sim.stop(5.0)
         if self.master is not None:
-            self.master.stop(10.0)
+            self.master.stop(5.0)
         if self.tmp is not None:
             shutil.rmtree(self.tmp, ignore_errors=True)
         return False
@@ -368,7 +371,7 @@ def _drive(session, report):
     _wait(lambda: rospy.has_param(SIM + "/loaded_mass"), START_TIMEOUT, "bullet_sim to load the model", session)
     cmd_topic = rospy.get_param(SIM + "/cmd_vel_topic", None)
     odom_topic = rospy.get_param(SIM + "/odom_topic", None)
-    _say(f"drive test: bullet_sim headless, fast mode; {cmd_topic} -> {odom_topic} and {SIM}/ground_truth")
+    _say(f"drive test (bullet_sim headless, 3x real time): {cmd_topic} -> {odom_topic}, {SIM}/ground_truth")
     logged = session.sim_warnings()
     extra = [w for w in logged if w not in report.warnings]
     for text in extra[:robot_report.MAX_WARNINGS]:
@@ -406,6 +409,11 @@ def _drive(session, report):
             sub.unregister()
     for line in robot_report.format_motions(straight, turn):
         _say(line)
+    during = [w for w in session.sim_warnings() if w not in logged and w not in report.warnings]
+    for text in during[:3]:
+        _say(f"  bullet_sim warned while driving: {text}")
+    if len(during) > 3:
+        _say(f"  ... and {len(during) - 3} more")
     if straight.passed and turn.passed:
         _say("result: PASS: the robot drives")
         return 0

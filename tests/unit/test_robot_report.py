@@ -1,0 +1,217 @@
+"""robot_report.py and drive_check.py: what robot_check says about the fixture robots, and how it judges a
+drive. No master: the report is built in-process (PyBullet DIRECT for the loaded mass)."""
+import os
+
+import pytest
+import yaml
+
+from diffbot_sim import drive_check, robot_report
+from diffbot_sim.errors import ConfigError, ModelError
+
+ROBOTS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "robots")
+
+
+def robot(name):
+    return os.path.join(ROBOTS, name)
+
+
+def controllers(*names):
+    out = []
+    for name in names:
+        with open(robot(name)) as handle:
+            out.append((robot(name), yaml.safe_load(handle)))
+    return out
+
+
+@pytest.fixture
+def report(tmp_path):
+    def build(model, *yamls, text=None):
+        path = robot(model)
+        if text is not None:
+            path = str(tmp_path / model)
+            with open(path, "w") as handle:
+                handle.write(text)
+        return robot_report.build_report(path, "", controllers(*yamls), cache_dir=str(tmp_path / "cache"))
+    return build
+
+
+def test_fixed_caster_diff_drive_from_its_tags(report):
+    r = report("fixed_caster.urdf")
+    assert r.name == "fixed_caster" and r.source == robot("fixed_caster.urdf")
+    assert r.urdf_mass == pytest.approx(1.0017) and r.loaded_mass == pytest.approx(1.0017, abs=1e-3)
+    drive = r.drive
+    assert drive.kind == "libgazebo_ros_diff_drive.so"
+    assert drive.where == "/robot/gazebo[5]/plugin[@name='differential_drive_controller']"
+    assert (drive.left, drive.right) == (["left_wheel_joint"], ["right_wheel_joint"])
+    assert drive.separation == pytest.approx(0.16) and drive.separation_from == "<wheelSeparation> tag"
+    assert drive.radius == pytest.approx(0.033) and drive.radius_from == "<wheelDiameter> tag / 2"
+    sensors = [i for i in r.items if i.kind == "sensor"]
+    assert [(s.name, s.what, s.simulated) for s in sensors] == [("imu", "imu", False)]
+    assert sensors[0].where == "/robot/gazebo[@reference='imu_link']/sensor[@name='imu']"
+    assert r.warnings == ["not simulated (ignored): sensor imu (type imu)"]
+
+
+def test_ros_control_drive_from_the_yaml_and_measured_geometry(report):
+    r = report("ros_control_4wd.urdf", "ros_control_4wd.yaml")
+    drive = r.drive
+    assert drive.kind == "diff_drive_controller/DiffDriveController"
+    assert drive.where == "/mobile_base_controller from ros_control_4wd.yaml"
+    assert drive.left == ["front_left_wheel_joint", "rear_left_wheel_joint"]
+    # 0.32 m between the front joints' origins, times the YAML's wheel_separation_multiplier 1.5
+    assert drive.separation == pytest.approx(0.48)
+    assert drive.separation_from == ("measured: origins of front_left_wheel_joint and front_right_wheel_joint, "
+                                     "x wheel_separation_multiplier 1.5")
+    assert drive.radius == pytest.approx(0.06)
+    assert drive.radius_from == "measured: cylinder collision of front_left_wheel_link"
+    kinds = {(i.kind, i.name): i.simulated for i in r.items}
+    assert kinds == {("plugin", "gazebo_ros_control"): True, ("controller", "/joint_state_controller"): True,
+                     ("controller", "/mobile_base_controller"): True}
+    assert r.warnings == ["/mobile_base_controller: parameters DiffDriveController does not read, ignored: "
+                          "/mobile_base_controller/k_l"]
+    assert r.urdf_mass == pytest.approx(6.2) and r.loaded_mass == pytest.approx(6.2, abs=1e-3)
+
+
+def test_ros_control_without_its_yaml_has_no_drive(report):
+    r = report("ros_control_4wd.urdf")
+    assert r.drive is None
+    assert any("no controller found on the parameter server under /" in w for w in r.warnings)
+    assert r.warnings[-1] == robot_report.NO_DRIVE
+
+
+def test_pid_robot_warns_about_its_sim_type_and_frame(report):
+    r = report("pid_robot.urdf", "pid_robot.yaml")
+    assert r.drive.where == "/diff_controller from pid_robot.yaml"
+    assert r.drive.separation == pytest.approx(0.26)
+    assert any("robotSimType 'vendor_hw_sim/VendorRobotHWSim' is not simulated" in w for w in r.warnings)
+    assert any("/diff_controller/base_frame_id '/base_footprint'" in w for w in r.warnings)
+
+
+def test_yaml_geometry_is_named_with_its_file(report, tmp_path):
+    tree = yaml.safe_load(open(robot("pid_robot.yaml")))
+    tree["diff_controller"].update(wheel_separation=0.3, wheel_radius=0.04)
+    r = robot_report.build_report(robot("pid_robot.urdf"), "", [("/x/mine.yaml", tree)],
+                                  cache_dir=str(tmp_path))
+    assert r.drive.separation == pytest.approx(0.3)
+    assert r.drive.separation_from == "/diff_controller/wheel_separation in mine.yaml"
+    assert r.drive.radius_from == "/diff_controller/wheel_radius in mine.yaml"
+
+
+def test_kobuki_skid_steer_and_planar_move(report):
+    kobuki = report("kobuki_style.urdf").drive
+    assert kobuki.kind == "libgazebo_ros_kobuki.so"
+    assert (kobuki.separation, kobuki.radius) == (pytest.approx(0.23), pytest.approx(0.035))
+    skid = report("skid_steer.urdf").drive
+    assert skid.kind == "libgazebo_ros_skid_steer_drive.so"
+    assert skid.right == ["front_right_wheel_joint", "rear_right_wheel_joint"]
+    assert skid.separation_from == "<wheelSeparation> tag"
+    planar = report("planar_robot.urdf").drive
+    assert planar.kind == "libgazebo_ros_planar_move.so" and "holonomic" in planar.note
+
+
+def test_geometry_measured_when_the_plugin_gives_none(report, make_urdf):
+    gazebo = """<gazebo><plugin name="dd" filename="libgazebo_ros_diff_drive.so">
+      <leftJoint>left_wheel_joint</leftJoint><rightJoint>right_wheel_joint</rightJoint>
+      <wheelTorque>5</wheelTorque><fancyTag>1</fancyTag></plugin></gazebo>"""
+    r = report("measured.urdf", text=make_urdf(separation=0.3, wheel_radius=0.05, gazebo=gazebo))
+    assert r.drive.separation == pytest.approx(0.3)
+    assert r.drive.separation_from == "measured: origins of left_wheel_joint and right_wheel_joint"
+    assert r.drive.radius == pytest.approx(0.05)
+    assert r.drive.radius_from == "measured: cylinder collision of left_wheel_link"
+    assert "/robot/gazebo[1]/plugin[@name='dd']: unknown tags ignored: fancyTag" in r.warnings
+
+
+def test_no_drive_fixture(report):
+    r = report("no_drive.urdf")
+    assert r.drive is None and r.urdf_mass == pytest.approx(1.4)
+    lines = robot_report.format_report(r)
+    assert any(line.startswith("drive: none found") for line in lines)
+    assert [(i.kind, i.name, i.simulated) for i in r.items] == [("sensor", "front_camera", False)]
+
+
+def test_a_bad_model_names_file_and_element(report, make_urdf):
+    bad = make_urdf(gazebo="""<gazebo><plugin name="dd" filename="libgazebo_ros_diff_drive.so">
+      <leftJoint>nope</leftJoint><rightJoint>right_wheel_joint</rightJoint></plugin></gazebo>""")
+    with pytest.raises(ModelError) as err:
+        report("bad.urdf", text=bad)
+    assert "bad.urdf" in str(err.value) and "/robot/gazebo[1]/plugin[@name='dd']" in str(err.value)
+    assert "'nope'" in str(err.value) and "\n" not in str(err.value)
+    with pytest.raises(ModelError, match="no such file"):
+        robot_report.build_report(robot("missing.urdf"))
+
+
+def test_a_bad_controller_parameter_is_named(report, tmp_path):
+    tree = yaml.safe_load(open(robot("pid_robot.yaml")))
+    tree["diff_controller"]["wheel_radius"] = -1
+    with pytest.raises(ConfigError, match="/diff_controller/wheel_radius"):
+        robot_report.build_report(robot("pid_robot.urdf"), "", [("c.yaml", tree)], cache_dir=str(tmp_path))
+
+
+@pytest.mark.parametrize("model, yamls", [("fixed_caster.urdf", ()), ("kobuki_style.urdf", ()),
+                                          ("ros_control_4wd.urdf", ("ros_control_4wd.yaml",)),
+                                          ("pid_robot.urdf", ("pid_robot.yaml",)), ("skid_steer.urdf", ()),
+                                          ("no_drive.urdf", ())])
+def test_the_report_fits_one_screen(report, model, yamls):
+    lines = robot_report.format_report(report(model, *yamls))
+    assert len(lines) + 6 <= 40  # the drive test adds at most six lines
+    assert lines[0].startswith("model: ") and lines[1].startswith("mass: URDF ")
+
+
+def test_mass_difference_is_shown():
+    r = robot_report.Report("/m.urdf", "m", 1.0, 2.0)
+    assert "differs by +1.0000 kg" in robot_report.format_report(r)[1]
+    r.loaded_mass = 1.0000001
+    assert "differs" not in robot_report.format_report(r)[1]
+
+
+def test_warnings_are_capped():
+    r = robot_report.Report("/m.urdf", "m", 1.0, 1.0, warnings=[f"w{i}" for i in range(25)])
+    lines = robot_report.format_report(r)
+    assert "  ... and 15 more" in lines and "warnings bullet_sim logs at start: 25" in lines
+
+
+def test_merge_params_updates_key_by_key_as_rosparam_load():
+    tree = robot_report.merge_params({}, "/", {"c": {"type": "a/B", "x": 1, "limits": {"v": 1}}})
+    robot_report.merge_params(tree, "/", {"c": {"x": 2, "limits": {"a": 3}}})
+    assert tree == {"c": {"type": "a/B", "x": 2, "limits": {"v": 1, "a": 3}}}
+    robot_report.merge_params(tree, "/robot1/", {"d": {"type": "a/B"}})
+    assert tree["robot1"] == {"d": {"type": "a/B"}}
+
+
+def test_find_controllers_looks_under_the_namespace_then_everywhere():
+    tree = {"robot1": {"c": {"type": "a/B"}}, "gazebo_ros_control": {"pid_gains": {"type": "x/Y"}},
+            "d": {"type": "c/D", "nested": {"type": "e/F"}}}
+    assert set(robot_report.find_controllers(tree, "/")) == {"/robot1/c", "/d"}
+    assert set(robot_report.find_controllers(tree, "/robot1")) == {"/robot1/c"}
+    assert set(robot_report.find_controllers(tree, "/elsewhere")) == {"/robot1/c", "/d"}
+
+
+# -------------------------------------------------------------------------------------------- drive_check
+
+def test_a_good_straight_run_passes_on_odometry_and_truth():
+    s = drive_check.straight((0, 0, 0), (0.79, 0.01, 0.01), (1, 1, 0), (1.8, 1.0, 0.0))
+    assert s.passed and s.odom_distance == pytest.approx(0.7901, abs=1e-3) and s.truth_distance == pytest.approx(0.8)
+
+
+@pytest.mark.parametrize("end_odom, end_truth, culprit", [
+    ((0.60, 0, 0), (0.8, 0, 0), "odometry: drove 0.600 m"),
+    ((0.8, 0, 0), (0.95, 0, 0), "ground truth: drove 0.950 m"),
+    ((0.8, 0, 0.2), (0.8, 0, 0), "odometry: heading changed 0.200 rad"),
+])
+def test_a_bad_straight_run_fails_naming_the_source(end_odom, end_truth, culprit):
+    s = drive_check.straight((0, 0, 0), end_odom, (0, 0, 0), end_truth)
+    assert not s.passed and any(f.startswith(culprit) for f in s.failures)
+
+
+def test_turn_judged_on_odometry_across_the_wrap():
+    # from 2.5 rad to -2.283 (= 2.5 + 1.5 - 2 pi): 1.5 rad turned through +-pi, 25 % short of 2.0: fails
+    t = drive_check.turn((0, 0, 2.5), (0, 0, 2.5 + 1.5 - 2 * 3.141592653589793), (0, 0, 0), (0, 0, 0.1))
+    assert t.odom_yaw == pytest.approx(1.5) and not t.passed
+    t = drive_check.turn((0, 0, 2.5), (0, 0, 2.5 + 1.9 - 2 * 3.141592653589793), (0, 0, 0), (0, 0, 0.1))
+    assert t.passed  # the ground truth is only judged when asked
+    t = drive_check.turn((0, 0, 0), (0, 0, 1.9), (0, 0, 0), (0.15, 0, 0.1), truth_fraction=0.5, max_moved=0.1)
+    assert [f.split(":")[0] for f in t.failures] == ["ground truth", "ground truth"]
+
+
+def test_yaw_from_quaternion():
+    import math
+    assert drive_check.yaw_from_quaternion(0, 0, math.sin(0.4), math.cos(0.4)) == pytest.approx(0.8)
