@@ -15,6 +15,8 @@ DEBS=(
   python3-rospkg python3-tf2-ros ros-robot-state-publisher
   python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-std-msgs python3-std-srvs
   python3-tf2-msgs python3-rosgraph-msgs
+  # map_server map images other than PGM (PNG, BMP...): diffbot_sim.world_map reads them with Pillow
+  python3-pil
   # tests
   python3-pytest liburdfdom-tools iproute2 procps python3-rosnode
   # teleop.launch opens the teleop in its own terminal window

@@ -141,7 +141,7 @@ class RobotSpec:
     """
 
     name: str = ""  # namespace; "" (single robot): the plugins' own namespaces and frames, unprefixed
-    model: str = ""  # .urdf/.urdf.xacro path; empty: /<name>/robot_description, else robot_description
+    model: str = ""  # .urdf/.urdf.xacro path; empty: ~model, then /<name>/robot_description, robot_description
     model_args: str = ""  # xacro arguments, "name:=value ..."
     x: float = 0.0  # m, spawn pose in the world
     y: float = 0.0
@@ -291,8 +291,8 @@ def robot_specs(sim, params):
                               f"one of the keys {', '.join(sorted(_ROBOT_KEYS))}")
         spec = RobotSpec()
         spec.name = _ros_name(f"{label}.name", entry.get("name"))
-        for key in ("model", "model_args"):
-            setattr(spec, key, _string(f"{label}.{key}", entry.get(key, ""), allow_empty=True))
+        for key in ("model", "model_args"):  # an entry without its own model shares ~model
+            setattr(spec, key, _string(f"{label}.{key}", entry.get(key, getattr(sim, key)), allow_empty=True))
         for key in ("x", "y", "z", "yaw"):
             setattr(spec, key, _number(f"{label}.{key}", entry.get(key, 0.0)))
         if entry.get("tf_prefix") is not None:

@@ -66,3 +66,10 @@ def test_the_unnamed_robot_is_left_alone():
     drive = DriveConfig(namespace="/ns")
     place_in_namespace(RobotSpec(), drive, None)
     assert (drive.namespace, drive.odometry_frame) == ("/ns", "odom")
+
+
+def test_robots_without_a_model_share_the_node_model():
+    sim = SimConfig(model="/m/robot.urdf.xacro", model_args="a:=1")
+    specs = robot_specs(sim, {"robots": [{"name": "r1"}, {"name": "r2", "y": 1.0, "model": "/m/other.urdf"}]})
+    assert (specs[0].model, specs[0].model_args) == ("/m/robot.urdf.xacro", "a:=1")
+    assert (specs[1].model, specs[1].model_args) == ("/m/other.urdf", "a:=1")

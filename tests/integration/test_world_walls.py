@@ -1,0 +1,77 @@
+#!/usr/bin/env python3
+"""Robots driven at a world's obstacles stop where the geometry says (through ROS: cmd_vel in, ground truth
+out). Each lane is one named robot of ``~robots``, driven at 0.3 m/s for 7 s of sim time from x = 0.
+
+Private parameter ~lanes: a list of {robot: NAME, stop: X} (the robot ends within 2 cm of x = X: an
+obstacle's face minus the robot's 0.1 m front) or {robot: NAME, beyond: X} (it pushed something past X).
+"""
+import sys
+import threading
+import time
+import unittest
+
+import rospy
+import rostest
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+
+SIM = "/bullet_sim"
+SPEED, SECONDS, TOLERANCE = 0.3, 7.0, 0.02
+
+
+class WorldWallsTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_world_walls")
+        cls.lanes = rospy.get_param("~lanes")
+        cls.lock = threading.Lock()
+        cls.truth = {}
+        cls.subs, cls.pubs = [], {}
+        for lane in cls.lanes:
+            name = lane["robot"]
+            cls.subs.append(rospy.Subscriber(f"{SIM}/{name}/ground_truth", Odometry, cls._keep,
+                                             callback_args=name, queue_size=1))
+            cls.pubs[name] = rospy.Publisher(f"/{name}/cmd_vel", Twist, queue_size=1)
+
+    @classmethod
+    def _keep(cls, msg, name):
+        with cls.lock:
+            cls.truth[name] = msg.pose.pose.position
+
+    def wait(self, predicate, timeout, what):
+        deadline = time.monotonic() + timeout
+        while not predicate():
+            if time.monotonic() > deadline or rospy.is_shutdown():
+                self.fail(f"timed out after {timeout} s waiting for {what}")
+            time.sleep(0.01)
+
+    def test_robots_stop_where_the_geometry_says(self):
+        names = [lane["robot"] for lane in self.lanes]
+        self.wait(lambda: all(n in self.truth for n in names), 60.0, "every robot's ground truth")
+        self.wait(lambda: all(self.pubs[n].get_num_connections() > 0 for n in names), 30.0, "the cmd_vel subscribers")
+        start = {n: self.truth[n].x for n in names}
+        for name in names:
+            self.assertAlmostEqual(start[name], 0.0, delta=0.02, msg=f"{name} did not start at x = 0")
+        msg = Twist()
+        msg.linear.x = SPEED
+        end = rospy.get_time() + SECONDS
+        while rospy.get_time() < end:
+            for name in names:
+                self.pubs[name].publish(msg)
+            rospy.sleep(0.05)
+        for name in names:
+            self.pubs[name].publish(Twist())
+        with self.lock:
+            final = {n: self.truth[n].x for n in names}
+        for lane in self.lanes:
+            name, x = lane["robot"], final[lane["robot"]]
+            rospy.loginfo(f"FIGURE {name}: ended at x = {x:.3f}")
+            if "stop" in lane:
+                self.assertAlmostEqual(x, lane["stop"], delta=TOLERANCE,
+                                       msg=f"{name} ended at x = {x:.3f}, the geometry says {lane['stop']}")
+            else:
+                self.assertGreater(x, lane["beyond"], f"{name} ended at x = {x:.3f}: nothing was pushed")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("diffbot_sim", "test_world_walls", WorldWallsTest, sys.argv)
