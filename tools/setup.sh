@@ -73,7 +73,7 @@ fi
 # the root itself would be a loop that roslib and rosrun walk into (each file found many times).
 PKG_LINK="$WS/src/diffbot_sim"
 mkdir -p "$PKG_LINK"
-for entry in package.xml CMakeLists.txt setup.py cmake src scripts launch urdf config tests; do
+for entry in package.xml CMakeLists.txt setup.py cmake src scripts launch urdf config tests worlds; do
   if [ ! -L "$PKG_LINK/$entry" ]; then
     ln -sfn "../../../$entry" "$PKG_LINK/$entry"
   fi
