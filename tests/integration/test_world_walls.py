@@ -3,7 +3,10 @@
 out). Each lane is one named robot of ``~robots``, driven at 0.3 m/s for 7 s of sim time from x = 0.
 
 Private parameter ~lanes: a list of {robot: NAME, stop: X} (the robot ends within 2 cm of x = X: an
-obstacle's face minus the robot's 0.1 m front) or {robot: NAME, beyond: X} (it pushed something past X).
+obstacle's face minus the robot's 0.1 m front), {robot: NAME, beyond: X} (it pushed something past X), or
+{robot: NAME, z: Z} (not driven: it was spawned onto a surface at height Z and rests there within 2 cm).
+~reset_world (bool): afterwards, /bullet_sim/reset_world puts every robot back at its start while sim time
+goes on.
 """
 import sys
 import threading
@@ -37,6 +40,7 @@ class WorldWallsTest(unittest.TestCase):
     def _keep(cls, msg, name):
         with cls.lock:
             cls.truth[name] = msg.pose.pose.position
+            cls.stamp = msg.header.stamp.to_sec()
 
     def wait(self, predicate, timeout, what):
         deadline = time.monotonic() + timeout
@@ -46,11 +50,13 @@ class WorldWallsTest(unittest.TestCase):
             time.sleep(0.01)
 
     def test_robots_stop_where_the_geometry_says(self):
-        names = [lane["robot"] for lane in self.lanes]
-        self.wait(lambda: all(n in self.truth for n in names), 60.0, "every robot's ground truth")
+        every = [lane["robot"] for lane in self.lanes]
+        names = [lane["robot"] for lane in self.lanes if "z" not in lane]
+        self.wait(lambda: all(n in self.truth for n in every), 60.0, "every robot's ground truth")
         self.wait(lambda: all(self.pubs[n].get_num_connections() > 0 for n in names), 30.0, "the cmd_vel subscribers")
-        start = {n: self.truth[n].x for n in names}
-        for name in names:
+        rospy.sleep(1.0)  # sim time: a robot dropped from a height has landed
+        start = {n: self.truth[n].x for n in every}
+        for name in every:
             self.assertAlmostEqual(start[name], 0.0, delta=0.02, msg=f"{name} did not start at x = 0")
         msg = Twist()
         msg.linear.x = SPEED
@@ -62,15 +68,35 @@ class WorldWallsTest(unittest.TestCase):
         for name in names:
             self.pubs[name].publish(Twist())
         with self.lock:
-            final = {n: self.truth[n].x for n in names}
+            final = {n: self.truth[n].x for n in every}
+            heights = {n: self.truth[n].z for n in every}
         for lane in self.lanes:
             name, x = lane["robot"], final[lane["robot"]]
+            if "z" in lane:
+                rospy.loginfo(f"FIGURE {name}: rests at z = {heights[name]:.3f}")
+                self.assertAlmostEqual(heights[name], lane["z"], delta=TOLERANCE, msg=f"{name} rests at z = "
+                                       f"{heights[name]:.3f}, the surface under it is at {lane['z']}")
+                continue
             rospy.loginfo(f"FIGURE {name}: ended at x = {x:.3f}")
             if "stop" in lane:
                 self.assertAlmostEqual(x, lane["stop"], delta=TOLERANCE,
                                        msg=f"{name} ended at x = {x:.3f}, the geometry says {lane['stop']}")
             else:
                 self.assertGreater(x, lane["beyond"], f"{name} ended at x = {x:.3f}: nothing was pushed")
+
+
+    def test_zz_reset_world_puts_robots_back_and_keeps_time(self):
+        """After the drive (methods run in name order): ~reset_world, as Gazebo's reset_world."""
+        if not rospy.get_param("~reset_world", False):
+            self.skipTest("~reset_world not asked for")
+        from std_srvs.srv import Empty
+        names = [lane["robot"] for lane in self.lanes]
+        self.wait(lambda: all(n in self.truth for n in names), 60.0, "every robot's ground truth")
+        before = rospy.get_time()
+        rospy.wait_for_service(SIM + "/reset_world", 10.0)
+        rospy.ServiceProxy(SIM + "/reset_world", Empty)()
+        self.wait(lambda: all(abs(self.truth[n].x) < 0.02 for n in names), 20.0, "every robot back at x = 0")
+        self.assertGreater(rospy.get_time(), before, "sim time went back on reset_world")
 
 
 if __name__ == "__main__":
