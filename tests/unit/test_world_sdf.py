@@ -140,7 +140,7 @@ def test_room_world_layout_state_and_model_uri():
     assert ring.shapes[0].mesh == os.path.join(ROOM_MODELS, "ring", "meshes", "ring.obj")
     assert near(ring.pose[0], (-1.5, -1.0, 0.0))
     box = b["pushable_box::link"]
-    assert not box.static and box.mass == 2.0 and box.inertia[:3] == (0.03, 0.03, 0.03)
+    assert not box.static and box.mass == 0.5 and box.inertia[:3] == (0.0075, 0.0075, 0.0075)
     assert near(box.pose[0], (2.0, 0.0, 0.15))  # moved by <state> from the model's (1.0, 1.2, 0.15)
     assert box.shapes[0].size == (0.3, 0.3, 0.3)
     assert all(body.static for name, body in b.items() if name != "pushable_box::link")
