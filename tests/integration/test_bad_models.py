@@ -77,6 +77,26 @@ class BadModelTest(unittest.TestCase):
     def test_missing_robot_description(self):
         self._run(None, "robot_description")
 
+    # -- worlds: one line naming the file (and line, or the URI and every directory searched) ----------
+    def _world(self, name):
+        return [f"_world:={os.path.join(DATA, 'bad_worlds', name)}"]
+
+    def test_malformed_world_names_file_and_line(self):
+        seed = os.path.join(rospkg.RosPack().get_path("diffbot_sim"), "urdf", "diffbot.urdf.xacro")
+        line = self._run(seed, "malformed.world", self._world("malformed.world"))
+        self.assertIn("line 5", line)
+
+    def test_unresolved_model_uri_names_uri_and_search_path(self):
+        seed = os.path.join(rospkg.RosPack().get_path("diffbot_sim"), "urdf", "diffbot.urdf.xacro")
+        line = self._run(seed, "model://no_such_model_anywhere", self._world("unresolved.world"))
+        self.assertIn("unresolved.world", line)
+        self.assertIn(".gazebo/models", line)
+
+    def test_unreadable_map_image(self):
+        seed = os.path.join(rospkg.RosPack().get_path("diffbot_sim"), "urdf", "diffbot.urdf.xacro")
+        line = self._run(seed, "not_an_image.pgm", self._world("unreadable_map.yaml"))
+        self.assertIn("unreadable_map.yaml", line)
+
 
 if __name__ == "__main__":
     rostest.rosrun("diffbot_sim", "test_bad_models", BadModelTest, sys.argv)
