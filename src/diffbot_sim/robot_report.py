@@ -146,15 +146,17 @@ def build_report(path, model_args="", controller_files=(), known=None, resolve_p
     Raises:
         ModelError, ConfigError: what would stop bullet_sim, naming the file, element or parameter.
     """
+    known_sensors = ()
     if known is None:
         from .plugins.registry import KNOWN as known  # imports the plugin modules (and rospy) only here
+        from .plugins.registry import KNOWN_SENSORS as known_sensors
     source = os.path.abspath(os.path.expanduser(path))
     text = load_file(source, parse_args(model_args))
     model = parse_urdf(text, source)
     text, mesh_notes = meshes.prepare_meshes(text, source, os.path.dirname(source),
                                              cache_dir or meshes.default_cache_dir(),
                                              resolve_package or _no_package)
-    found = read_plugins(model, known=known)
+    found = read_plugins(model, known=known, known_sensors=known_sensors)
     for trans in model.transmissions:
         model.joint(trans.joint, f"/robot/transmission[@name='{trans.name}']")
     tree = {}

@@ -354,7 +354,7 @@ def _build_robot(sim, cfg, spec, params):
     base_dir = os.path.dirname(source) if os.path.isfile(source) else os.getcwd()
     text, mesh_notes = meshes.prepare_meshes(text, source, base_dir, meshes.default_cache_dir(),
                                              _package_path)
-    found = read_plugins(model, known=registry.KNOWN)
+    found = read_plugins(model, known=registry.KNOWN, known_sensors=registry.KNOWN_SENSORS)
     for trans in model.transmissions:
         model.joint(trans.joint, f"/robot/transmission[@name='{trans.name}']")
     z = max(spec.z, sim.world.top_at(spec.x, spec.y)) if sim.world.world_bodies else spec.z

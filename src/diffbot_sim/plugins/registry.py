@@ -15,8 +15,16 @@ MODEL_PLUGINS = {
     "libgazebo_ros_kobuki.so": kobuki.create,
     "libgazebo_ros_control.so": ros_control.create,
 }
+#: Sensor plugins by filename: ``create(ctx, sensor, plugin_element, params)`` with ``sensor`` a
+#: :class:`~diffbot_sim.plugins.tags.SensorElement` (its type, link, element and path). One line per module.
+SENSOR_PLUGINS = {
+}
+#: Sensors simulated without a plugin of their own, by type (``create(ctx, sensor, None, params)``).
+SENSOR_TYPES = {
+}
 #: Every filename simulated (the rest are named once as not simulated).
 KNOWN = (DIFF_DRIVE, JOINT_STATE) + tuple(MODEL_PLUGINS)
+KNOWN_SENSORS = tuple(SENSOR_PLUGINS) + tuple(f"type:{t}" for t in SENSOR_TYPES)
 
 
 def build(ctx, found, params):
@@ -34,6 +42,20 @@ def build(ctx, found, params):
         factory = MODEL_PLUGINS.get(item.filename)
         if factory is not None:
             plugins.append(factory(ctx, item.element, item.path, params))
+    for sensor in found.sensors:
+        for plugin in sensor.element.findall("plugin"):
+            base = (plugin.get("filename") or "").strip().rsplit("/", 1)[-1]
+            base = base if base.endswith(".so") else (f"lib{base}.so" if not base.startswith("lib") else f"{base}.so")
+            factory = SENSOR_PLUGINS.get(base)
+            if factory is not None:
+                plugins.append(factory(ctx, sensor, plugin, params))
+                break
+        else:
+            factory = SENSOR_TYPES.get(sensor.type)
+            if factory is not None:
+                made = factory(ctx, sensor, None, params)
+                if made is not None:
+                    plugins.append(made)
     js = joint_state.create(ctx, found.joint_state, drive.drive if drive is not None else None)
     if js is not None:
         plugins.append(js)

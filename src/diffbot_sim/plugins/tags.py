@@ -71,18 +71,34 @@ class PluginElement:
 
 
 @dataclass
+class SensorElement:
+    """A ``<sensor>`` of a ``<gazebo reference=link>`` block: its type, the link it is mounted on, and the
+    ``<plugin>``s inside it (normalised filenames), which decide who simulates it."""
+
+    type: str
+    name: str
+    link: Optional[str]
+    element: ET.Element
+    path: str
+    plugins: List[str] = field(default_factory=list)
+
+
+@dataclass
 class Plugins:
     diff_drive: Optional[PluginBlock] = None
     joint_state: Optional[PluginBlock] = None
     others: List[PluginElement] = field(default_factory=list)  # every other plugin, in model order
+    sensors: List[SensorElement] = field(default_factory=list)  # every <sensor>, in model order
     unsupported: List[str] = field(default_factory=list)  # plugins and sensors we do not simulate
     warnings: List[str] = field(default_factory=list)
 
 
-def read_plugins(model, known=NATIVE):
+def read_plugins(model, known=NATIVE, known_sensors=()):
     """Collect the plugin blocks of ``model`` (a RobotModel): the diff drive and joint-state publisher read
     into PluginBlocks, every other plugin as a PluginElement; those whose filename is not in ``known``
-    (nor one of the two) are also named in ``unsupported``.
+    (nor one of the two) are also named in ``unsupported``. Every ``<sensor>`` is collected in ``sensors``;
+    one whose type and plugins match nothing in ``known_sensors`` (filenames, or ``type:NAME`` for a sensor
+    simulated without a plugin) is named in ``unsupported`` too.
 
     Raises:
         ModelError: a plugin without a filename.
@@ -112,8 +128,19 @@ def read_plugins(model, known=NATIVE):
                 found.others.append(PluginElement(base, name, el, path))
                 if base not in known:
                     found.unsupported.append(f"plugin {name} ({filename})")
-        for el in block.element.iter("sensor"):
-            found.unsupported.append(f"sensor {el.get('name') or '?'} (type {el.get('type') or '?'})")
+        for index, el in enumerate(block.element.iter("sensor"), start=1):
+            sname, stype = el.get("name") or "", el.get("type") or ""
+            path = f"{block.path}/sensor[@name='{sname}']" if sname else f"{block.path}/sensor[{index}]"
+            plugins = []
+            for plugin in el.findall("plugin"):
+                base = (plugin.get("filename") or "").strip().rsplit("/", 1)[-1]
+                if base and not base.endswith(".so"):
+                    base = f"lib{base}.so" if not base.startswith("lib") else f"{base}.so"
+                if base:
+                    plugins.append(base)
+            found.sensors.append(SensorElement(stype, sname, block.reference, el, path, plugins))
+            if not any(p in known_sensors for p in plugins) and f"type:{stype}" not in known_sensors:
+                found.unsupported.append(f"sensor {sname or '?'} (type {stype or '?'})")
     return found
 
 
