@@ -17,6 +17,10 @@ Items (issue 9):
              with an empty mesh cache and with the cache filled; median of 3 each.
   ros_control  fast-mode RTF of the four-wheel ros_control fixture (diff_drive_controller from its YAML),
              its odom, /joint_states and /tf each subscribed by a process of its own; median of 3.
+Items (issue 10):
+  worlds     roslaunch -> first /odom in a world of 30 models with COLLADA collision meshes (empty mesh
+             cache), and with a 4000 x 4000 map image (a floor plan, and the same with 2 % speckle);
+             fast-mode RTF of the seed robot in worlds/room.world against the empty world (medians of 3).
 """
 import argparse
 import json
@@ -445,6 +449,80 @@ def bench_ros_control(seconds, repeats):
     return dict(trials[rtfs.index(statistics.median_low(rtfs))], rtf=statistics.median(rtfs), rtf_runs=rtfs)
 
 
+DAE = """<?xml version="1.0"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit meter="0.001"/><up_axis>Z_UP</up_axis></asset>
+  <library_geometries><geometry id="g"><mesh>
+    <source id="p"><float_array id="pa" count="{count}">{points}</float_array>
+      <technique_common><accessor source="#pa" count="{vcount}" stride="3"><param name="X" type="float"/>
+      <param name="Y" type="float"/><param name="Z" type="float"/></accessor></technique_common></source>
+    <vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+    <triangles count="{tcount}"><input semantic="VERTEX" source="#v" offset="0"/><p>{indices}</p></triangles>
+  </mesh></geometry></library_geometries>
+  <library_visual_scenes><visual_scene id="s"><node><instance_geometry url="#g"/></node></visual_scene>
+  </library_visual_scenes><scene><instance_visual_scene url="#s"/></scene>
+</COLLADA>
+"""
+
+
+def mesh_world(models=30, segments=64):
+    """A world of ``models`` static models, each a cylinder-ish COLLADA mesh (mm units) of its own file."""
+    import math
+    folder = os.path.join(RESULTS, "mesh_world")
+    os.makedirs(folder, exist_ok=True)
+    lines = ['<?xml version="1.0"?>', '<sdf version="1.6"><world name="mesh_world">',
+             "<include><uri>model://ground_plane</uri></include><include><uri>model://sun</uri></include>"]
+    for k in range(models):
+        r = 150.0 + 5 * k
+        points, tris = [], []
+        for i in range(segments):
+            a = 2 * math.pi * i / segments
+            points += [(r * math.cos(a), r * math.sin(a), 0.0), (r * math.cos(a), r * math.sin(a), 800.0)]
+        for i in range(segments):
+            j = (i + 1) % segments
+            tris += [(2 * i, 2 * j, 2 * j + 1), (2 * i, 2 * j + 1, 2 * i + 1)]
+        name = os.path.join(folder, f"obstacle{k}.dae")
+        with open(name, "w") as f:
+            f.write(DAE.format(count=3 * len(points), vcount=len(points), tcount=len(tris),
+                               points=" ".join(f"{c:g}" for pt in points for c in pt),
+                               indices=" ".join(str(i) for t in tris for i in t)))
+        x, y = 2.0 + 1.5 * (k % 6), -4.0 + 1.5 * (k // 6)
+        lines.append(f'<model name="obstacle{k}"><static>true</static><pose>{x} {y} 0 0 0 0</pose><link name="l">'
+                     f'<collision name="c"><geometry><mesh><uri>obstacle{k}.dae</uri></mesh></geometry></collision>'
+                     f"</link></model>")
+    lines.append("</world></sdf>")
+    path = os.path.join(folder, "mesh_world.world")
+    with open(path, "w") as f:
+        f.write("\n".join(lines))
+    return path
+
+
+def bench_worlds(runs, seconds):
+    """Load times of a mesh world and of 4000 x 4000 maps; RTF in the example world against none."""
+    import shutil
+    sys.path.insert(0, os.path.join(ROOT, "src"))
+    from diffbot_sim import world_map
+    out = {}
+    home = os.path.join(RESULTS, "ros_home_worlds")
+    cache = os.path.join(home, "diffbot_sim", "mesh_cache")
+    world = mesh_world()
+    out["mesh_world"] = bench_startup(runs, (f"world:={world}", "robot_state_publisher:=false"), home,
+                                      lambda: shutil.rmtree(cache, ignore_errors=True))
+    for key, noise in (("map_floor_plan", 0.0), ("map_speckled", 0.02)):
+        path = world_map.synthetic_map(os.path.join(RESULTS, f"{key}.yaml"), size=4000, noise=noise)
+        out[key] = bench_startup(runs, (f"world:={path}", "robot_state_publisher:=false"), home)
+    rtf = {"room": [], "empty": []}
+    for _ in range(runs):
+        for key, extra in (("room", (f"world:={os.path.join(ROOT, 'worlds', 'room.world')}",)), ("empty", ())):
+            with Launch(sim_args("real_time:=false", "robot_state_publisher:=false", *extra), f"world_{key}") as launch:
+                for topic in TOPICS[1:]:
+                    subscriber(launch, [topic])
+                rtf[key].append(launch.probe("rtf", seconds=seconds, warmup=3.0)["rtf"])
+    out["rtf_room"], out["rtf_empty"] = statistics.median(rtf["room"]), statistics.median(rtf["empty"])
+    out["rtf_runs"] = rtf
+    return out
+
+
 def scale_launch(count, rsp):
     """A real-time launch file for ``count`` namespaced seed robots on a 1 m grid (like multi.launch), each
     with its robot_state_publisher when ``rsp``."""
@@ -538,6 +616,14 @@ def table(r):
         rows += [(f"first /odom, {m['stl_bytes'] / 1e6:.1f} MB STL, empty mesh cache", f"{m['cold']['median_s']:.2f} s",
                   "<= 2 s"),
                  ("  same, mesh cache filled", f"{m['cached']['median_s']:.2f} s", "")]
+    if r.get("worlds"):
+        w = r["worlds"]
+        rows += [("first /odom, world of 30 COLLADA mesh models (empty cache)", f"{w['mesh_world']['median_s']:.2f} s",
+                  "<= 3 s"),
+                 ("first /odom, 4000 x 4000 map, floor plan", f"{w['map_floor_plan']['median_s']:.2f} s", "<= 3 s"),
+                 ("first /odom, 4000 x 4000 map, 2 % speckle", f"{w['map_speckled']['median_s']:.2f} s", "<= 3 s"),
+                 ("fast-mode RTF in worlds/room.world / empty world",
+                  f"{w['rtf_room']:.1f} / {w['rtf_empty']:.1f} = {w['rtf_room'] / w['rtf_empty']:.2f}", ">= 0.8")]
     if r.get("ros_control"):
         rows.append(("fast-mode RTF, 4-wheel ros_control robot (DDC)", f"{r['ros_control']['rtf']:.1f}", ">= 30"))
     for key, label in (("scale", "robots at RTF >= 1 (all topics)"),
@@ -557,7 +643,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--probe", choices=sorted(PROBES), help=argparse.SUPPRESS)
     parser.add_argument("--options", default="{}", help=argparse.SUPPRESS)
-    parser.add_argument("--only", default="fast,realtime,latency,startup,scale,meshes,ros_control",
+    parser.add_argument("--only", default="fast,realtime,latency,startup,scale,meshes,ros_control,worlds",
                         help="comma-separated items to run (default: all)")
     parser.add_argument("--quick", action="store_true", help="shorter windows (smoke run, not for figures)")
     args = parser.parse_args()
@@ -573,7 +659,8 @@ def main():
              ("startup", lambda: bench_startup(2 if q else 5)), ("scale", lambda: bench_scale(4 if q else 8, False)),
              ("scale_rsp", lambda: bench_scale(4 if q else 8, True)),
              ("meshes", lambda: bench_meshes(1 if q else 3)),
-             ("ros_control", lambda: bench_ros_control(4 if q else 12, 1 if q else 3))]
+             ("ros_control", lambda: bench_ros_control(4 if q else 12, 1 if q else 3)),
+             ("worlds", lambda: bench_worlds(1 if q else 3, 4 if q else 10))]
     for name, run in steps:
         wanted = name in items or (name == "scale_rsp" and "scale" in items)
         if not wanted:
