@@ -57,6 +57,20 @@ def load_file(path, args=None):
             xacro.all_includes = []
 
 
+def package_path(package):
+    """rospkg's path of ROS package ``package``, for ``package://`` URIs.
+
+    Raises:
+        LookupError: no such package on ROS_PACKAGE_PATH.
+    """
+    import rospkg  # lazy
+
+    try:
+        return rospkg.RosPack().get_path(package)
+    except rospkg.ResourceNotFound as err:
+        raise LookupError(package) from err
+
+
 def resolve_uri(uri, source):
     """``package://pkg/path`` (via rospkg) or ``file://path`` -> an absolute file path PyBullet can open."""
     if uri.startswith("package://"):

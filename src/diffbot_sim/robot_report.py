@@ -15,6 +15,7 @@ from typing import List, Optional
 
 from . import config as cfgmod
 from . import ddc, meshes
+from .controllers import find_controllers
 from .description import load_file, parse_args
 from .model import parse_urdf, tag_value
 from .plugins.tags import DIFF_DRIVE, JOINT_STATE, read_plugins
@@ -95,34 +96,6 @@ def _update(node, values):
             _update(node[key], value)
         else:
             node[key] = value
-
-
-def _subtree(tree, namespace):
-    node = tree
-    for part in [p for p in namespace.split("/") if p]:
-        node = node.get(part) if isinstance(node, dict) else None
-    return node if isinstance(node, dict) else {}
-
-
-def find_controllers(tree, namespace):
-    """{controller namespace: parameters} of every dict with a ``pkg/Type`` under ``namespace``; none there:
-    anywhere in ``tree``. The walk gazebo_ros_control's stand-in (plugins.ros_control) makes on the server."""
-    def walk(prefix, node, out):
-        if not isinstance(node, dict):
-            return
-        if isinstance(node.get("type"), str) and "/" in node["type"]:
-            out[prefix] = node
-            return
-        for key, value in node.items():
-            if key != "gazebo_ros_control":
-                walk(prefix.rstrip("/") + "/" + key, value, out)
-
-    ns = "/" + namespace.strip("/")
-    found = {}
-    walk(ns, _subtree(tree, ns), found)
-    if not found and ns != "/":
-        walk("/", tree, found)
-    return found
 
 
 # --------------------------------------------------------------------------------------------- report

@@ -29,6 +29,7 @@ import threading
 import time
 
 from .. import drive_check, robot_report, streams
+from ..description import package_path
 from ..errors import DiffbotSimError, ModelError
 
 USAGE = ("usage: rosrun diffbot_sim robot_check <model.urdf|model.urdf.xacro> [controller.yaml ...] "
@@ -103,7 +104,7 @@ def _main(argv):
         files = [(path, _load_yaml(path)) for path in yamls]
         from ..plugins.registry import KNOWN
         report = robot_report.build_report(model, model_args, [(p, tree) for p, (tree, _) in files], KNOWN,
-                                           _package_path)
+                                           package_path)
     except DiffbotSimError as err:
         streams.write(sys.stderr, f"robot_check: {err}\n")
         return 1
@@ -150,15 +151,6 @@ def _load_yaml(path):
             raise ModelError(f"not a mapping of parameters (a {type(values).__name__})", path)
         robot_report.merge_params(tree, ns or "/", values)
     return tree, docs
-
-
-def _package_path(package):
-    import rospkg
-
-    try:
-        return rospkg.RosPack().get_path(package)
-    except rospkg.ResourceNotFound as err:
-        raise LookupError(package) from err
 
 
 # ------------------------------------------------------------------------------------------- processes

@@ -29,7 +29,7 @@ from tf2_msgs.msg import TFMessage
 
 from .. import config as cfgmod
 from .. import meshes, ros_msgs, streams
-from ..description import load_file, parse_args
+from ..description import load_file, package_path, parse_args
 from ..errors import DiffbotSimError, ModelError
 from ..model import parse_urdf
 from ..physics import World
@@ -353,7 +353,7 @@ def _build_robot(sim, cfg, spec, params):
     model = parse_urdf(text, source)
     base_dir = os.path.dirname(source) if os.path.isfile(source) else os.getcwd()
     text, mesh_notes = meshes.prepare_meshes(text, source, base_dir, meshes.default_cache_dir(),
-                                             _package_path)
+                                             package_path)
     found = read_plugins(model, known=registry.KNOWN, known_sensors=registry.KNOWN_SENSORS)
     for trans in model.transmissions:
         model.joint(trans.joint, f"/robot/transmission[@name='{trans.name}']")
@@ -364,16 +364,6 @@ def _build_robot(sim, cfg, spec, params):
     runtime = RobotRuntime(ctx, registry.build(ctx, found, params))
     sim.add_robot(runtime)
     return LoadedRobot(spec, model, found, runtime, model.warnings + mesh_notes + ctx.warnings)
-
-
-def _package_path(package):
-    """rospkg's path of ``package`` (LookupError when unknown), for package:// mesh URIs."""
-    import rospkg
-
-    try:
-        return rospkg.RosPack().get_path(package)
-    except rospkg.ResourceNotFound as err:
-        raise LookupError(package) from err
 
 
 def _read_world(cfg):

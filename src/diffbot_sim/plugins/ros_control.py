@@ -32,7 +32,7 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Bool, Float64
 
-from .. import ddc, ros_msgs
+from .. import controllers, ddc, ros_msgs
 from ..config import _number, _string
 from ..errors import ConfigError, ModelError
 from ..kinematics import quaternion_from_yaw
@@ -399,23 +399,9 @@ def _param(name, default):
 
 
 def find_controllers(ns):
-    """{controller namespace: its parameter dict} of every dict with a ``type`` under ``ns`` (recursively);
-    none there: anywhere on the parameter server (a launch file that namespaced its controllers)."""
-    def walk(prefix, tree, out):
-        if not isinstance(tree, dict):
-            return
-        if isinstance(tree.get("type"), str) and "/" in tree["type"]:
-            out[prefix] = tree
-            return
-        for key, value in tree.items():
-            if key != "gazebo_ros_control":
-                walk(join(prefix, key) if prefix != "/" else "/" + key, value, out)
-
-    found = {}
-    walk(ns if ns.startswith("/") else "/" + ns, _param(ns or "/", {}), found)
-    if not found and ns.strip("/"):
-        walk("/", _param("/", {}), found)
-    return found
+    """{controller namespace: its parameter dict} of every controller under ``ns`` on the parameter server,
+    else anywhere on it (:func:`diffbot_sim.controllers.find_controllers`)."""
+    return controllers.find_controllers(_param("/", {}), ns or "/")
 
 
 def create(ctx, element, path, params):
