@@ -19,6 +19,8 @@ DEBS=(
   python3-pil
   # tests
   python3-pytest liburdfdom-tools iproute2 procps python3-rosnode
+  # tests: sensor_laser.test projects LaserScans to point clouds as ROS users do (laser_geometry)
+  python3-laser-geometry
   # teleop.launch opens the teleop in its own terminal window
   xterm
 )

@@ -19,6 +19,10 @@ GAZEBO_DEFAULT_MU = 1.0
 #: link that gives only one of the two.
 GAZEBO_DEFAULT_KP = 1e12
 GAZEBO_DEFAULT_KD = 1.0
+#: Rays per rayTestBatch call. PyBullet's limit is MAX_RAY_INTERSECTION_BATCH_SIZE_STREAMING (16 x 1024 on
+#: Linux); at exactly 16384 it returns 16383 results for list input and none for numpy input (bullet3 #4215,
+#: measured here: sensors.md section 6.1), and above it raises. 16383 works both ways.
+RAY_BATCH_LIMIT = 16383
 
 
 @contextlib.contextmanager
@@ -61,6 +65,7 @@ class World:
         self._files = []
         self.robots = []
         self.world_bodies = []  # (PyBullet id, world.Body)
+        self.laser_retro = {}  # (PyBullet body, link index) -> Gazebo laser_retro, for hits that have one
         self._setup()
 
     def _setup(self):
@@ -95,6 +100,7 @@ class World:
         robot = Robot(self.client, body, model, position, orientation, prepared.frames)
         robot.gravity = self.gravity
         self.robots.append(robot)
+        self.laser_retro.update(robot.laser_retro())
         return robot
 
     def load_world(self, world, mesh_cache):
@@ -138,7 +144,11 @@ class World:
                 ixx, iyy, izz = body.inertia[:3]
                 options["localInertiaDiagonal"] = (ixx, iyy, izz)
             pybullet.changeDynamics(uid, -1, physicsClientId=c, **options)
+            if body.color is not None:  # the collision-derived visual, coloured (what cameras see)
+                pybullet.changeVisualShape(uid, -1, rgbaColor=body.color, physicsClientId=c)
             self.world_bodies.append((uid, body))
+            if body.shapes[0].surface.get("laser_retro"):
+                self.laser_retro[(uid, -1)] = float(body.shapes[0].surface["laser_retro"])
             built += 1
         return built
 
@@ -204,8 +214,87 @@ class World:
                 top = max(top, hit[3][2])
         return top
 
+    def ray_batch(self, starts, ends):
+        """Cast rays from ``starts`` to ``ends`` (world, (N, 3)) against everything: world bodies, every
+        robot and the casting robot's own links (Gazebo's CPU ray sensor filters nothing either). Cast in
+        calls of at most RAY_BATCH_LIMIT rays (PyBullet's per-call limit), numpy in and out.
+
+        Returns:
+            (hit fractions along start->end, 1.0 for a miss; hit PyBullet body ids, -1 for a miss; hit link
+            indices, -1 for a base or a miss): numpy arrays of N values.
+        """
+        import numpy as np
+
+        starts = np.ascontiguousarray(starts, dtype=np.float64).reshape(-1, 3)
+        ends = np.ascontiguousarray(ends, dtype=np.float64).reshape(-1, 3)
+        count = len(starts)
+        fractions = np.ones(count)
+        bodies = np.full(count, -1, dtype=np.int64)
+        links = np.full(count, -1, dtype=np.int64)
+        for lo in range(0, count, RAY_BATCH_LIMIT):
+            hi = min(lo + RAY_BATCH_LIMIT, count)
+            # numThreads 0: PyBullet picks max(1, rays / 16) threads of its pool.
+            hits = pybullet.rayTestBatch(starts[lo:hi], ends[lo:hi], numThreads=0, physicsClientId=self.client)
+            if len(hits) != hi - lo:
+                raise RuntimeError(f"rayTestBatch returned {len(hits)} results for {hi - lo} rays")
+            bodies[lo:hi] = [h[0] for h in hits]
+            links[lo:hi] = [h[1] for h in hits]
+            fractions[lo:hi] = [h[2] for h in hits]
+        fractions[bodies < 0] = 1.0
+        return fractions, bodies, links
+
+    def retro(self, bodies, links):
+        """Gazebo ``laser_retro`` of each hit (body, link) (0 where none is given, and for misses)."""
+        import numpy as np
+
+        if not self.laser_retro:
+            return np.zeros(len(bodies))
+        table = self.laser_retro
+        return np.array([table.get((b, k), 0.0) for b, k in zip(bodies.tolist(), links.tolist())], dtype=float)
+
     def step(self):
         pybullet.stepSimulation(physicsClientId=self.client)
+
+    def render(self, view_pose, width, height, hfov, near, far, renderer="tiny"):
+        """A camera image from ``view_pose`` ((x, y, z), (qx, qy, qz, qw)) looking along that frame's +x, up
+        its +z (a Gazebo camera): (rgb uint8 (h, w, 3), z-depth float32 (h, w) [m], NaN where nothing was hit
+        or beyond ``far``). ``hfov`` [rad] is SDF's horizontal FOV. ``renderer`` "tiny": PyBullet's CPU
+        TinyRenderer; "egl": the EGL plugin (``use_egl`` must have succeeded; else TinyRenderer draws)."""
+        import numpy as np
+
+        from . import camera_sensor
+        c = self.client
+        eye, target, up = camera_sensor.look_at(view_pose)
+        view = pybullet.computeViewMatrix(eye, target, up, physicsClientId=c)
+        proj = pybullet.computeProjectionMatrixFOV(camera_sensor.vertical_fov_degrees(hfov, width, height),
+                                                   width / height, near, far, physicsClientId=c)
+        kind = pybullet.ER_BULLET_HARDWARE_OPENGL if renderer == "egl" else pybullet.ER_TINY_RENDERER
+        _, _, rgba, depth, _ = pybullet.getCameraImage(width, height, view, proj, renderer=kind,
+                                                       flags=pybullet.ER_NO_SEGMENTATION_MASK, physicsClientId=c)
+        rgb = np.ascontiguousarray(np.asarray(rgba, np.uint8).reshape(height, width, 4)[:, :, :3])
+        return rgb, camera_sensor.linear_depth(np.asarray(depth, np.float32).reshape(height, width), near, far)
+
+    def use_egl(self):
+        """Load PyBullet's EGL renderer plugin (OpenGL off screen; Mesa's llvmpipe without a GPU). Returns
+        None when it draws this world, else why not (the caller falls back to TinyRenderer). The plugin only
+        sees bodies created after it loads, so it must be loaded before the world and robots are."""
+        if getattr(self, "_egl", None) is not None:
+            return None
+        if self.world_bodies or self.robots:
+            return "the EGL plugin only draws bodies created after it loads, and this world is built already"
+        import pkgutil
+        loader = pkgutil.get_loader("eglRenderer")
+        if loader is None:
+            return "pybullet has no eglRenderer module"
+        with _quiet(1), _quiet(2):
+            plugin = pybullet.loadPlugin(loader.get_filename(), "_eglRendererPlugin", physicsClientId=self.client)
+        if plugin < 0:
+            return "pybullet could not load its EGL plugin (no EGL/OpenGL library?)"
+        self._egl = plugin
+        if self.plane is not None:  # recreate our plane so that the plugin draws it
+            pybullet.removeBody(self.plane, physicsClientId=self.client)
+            self.plane = pybullet.loadURDF("plane.urdf", physicsClientId=self.client)
+        return None
 
     def reset(self):
         """Put every robot back at its spawn pose and every dynamic world body at its start, at rest."""
@@ -265,6 +354,19 @@ class Robot:
                 if kp > 0:
                     options.update(contactStiffness=kp, contactDamping=max(kd, 0.0))
             pybullet.changeDynamics(self.body, index, physicsClientId=self.client, **options)
+
+    def laser_retro(self):
+        """{(body, PyBullet link index): laserRetro} of links whose ``<gazebo reference>`` gives one. A
+        PyBullet link carrying lumped links takes its own value, else the first lumped link's (PyBullet does
+        not say which shape of a link a ray hit)."""
+        table = {}
+        frames = self.frames or {name: (name, None, None) for name in self._link_index}
+        for link, (carrier, _, _) in sorted(frames.items(), key=lambda item: item[0] != item[1][0]):
+            value = self.model.surface(link).get("laserRetro")
+            key = (self.body, self._link_index.get(carrier, -1))
+            if value and key not in table:
+                table[key] = float(value)
+        return table
 
     def link_pose(self, name):
         """World pose ((x, y, z), (qx, qy, qz, qw)) of URDF link ``name``'s frame, lumped or not.
@@ -356,6 +458,66 @@ class Robot:
         _, inverse = pybullet.invertTransform((0, 0, 0), pose[1])
         local, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, accel, (0, 0, 0, 1))
         return tuple(local)
+
+    def link_motion(self, name):
+        """URDF link ``name``'s frame (lumped or not) in the world: (pose ((x, y, z), (qx, qy, qz, qw)),
+        linear velocity of the frame's origin (v + w x r from the carrier's centre of mass) [m/s], angular
+        velocity [rad/s]), both velocities in world axes. A lumped link moves with its carrier.
+
+        Raises:
+            KeyError: the model has no such link.
+        """
+        carrier, xyz, quat = self.frames[name] if self.frames else (name, (0, 0, 0), (0, 0, 0, 1))
+        index = self._link_index[carrier]
+        c = self.client
+        if index == -1:
+            com, _ = pybullet.getBasePositionAndOrientation(self.body, physicsClientId=c)
+            linear, angular = pybullet.getBaseVelocity(self.body, physicsClientId=c)
+            frame = self.base_pose()
+        else:
+            state = pybullet.getLinkState(self.body, index, computeLinkVelocity=1, computeForwardKinematics=1,
+                                          physicsClientId=c)
+            com, frame, linear, angular = state[0], (state[4], state[5]), state[6], state[7]
+        pose = pybullet.multiplyTransforms(frame[0], frame[1], xyz, quat)
+        r = [pose[0][i] - com[i] for i in range(3)]
+        v = (linear[0] + angular[1] * r[2] - angular[2] * r[1],
+             linear[1] + angular[2] * r[0] - angular[0] * r[2],
+             linear[2] + angular[0] * r[1] - angular[1] * r[0])
+        return (tuple(pose[0]), tuple(pose[1])), v, tuple(angular)
+
+    def link_twist(self, name):
+        """(pose, linear velocity [m/s], angular velocity [rad/s]) of URDF link ``name``'s frame, the
+        velocities in that frame's own axes (as ``base_twist`` for the root)."""
+        pose, linear, angular = self.link_motion(name)
+        _, inverse = pybullet.invertTransform((0, 0, 0), pose[1])
+        local_v, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, linear, (0, 0, 0, 1))
+        local_w, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, angular, (0, 0, 0, 1))
+        return pose, tuple(local_v), tuple(local_w)
+
+    def link_imu(self, name, previous_velocity, dt, offset=None):
+        """What an IMU on URDF link ``name`` (lumped or not) reads, in the link's frame (or in the frame at
+        ``offset`` = ((x, y, z), (qx, qy, qz, qw)) in the link's, an SDF sensor ``<pose>``): (pose, angular
+        velocity [rad/s], proper acceleration [m/s^2], world velocity of the frame origin). The acceleration
+        is the finite difference of the origin's world velocity since ``previous_velocity`` (the value this
+        call returned ``dt`` seconds ago; None or dt <= 0: taken as unchanged) minus gravity, so it reads
+        +9.81 on an upward z at rest (REP 145). The caller keeps the velocity: no state here."""
+        pose, linear, angular = self.link_motion(name)
+        if offset is not None:
+            moved = pybullet.multiplyTransforms(pose[0], pose[1], offset[0], offset[1])
+            r = [moved[0][i] - pose[0][i] for i in range(3)]
+            linear = (linear[0] + angular[1] * r[2] - angular[2] * r[1],
+                      linear[1] + angular[2] * r[0] - angular[0] * r[2],
+                      linear[2] + angular[0] * r[1] - angular[1] * r[0])
+            pose = (tuple(moved[0]), tuple(moved[1]))
+        if previous_velocity is None or dt <= 0:
+            accel = [0.0, 0.0, 0.0]
+        else:
+            accel = [(linear[i] - previous_velocity[i]) / dt for i in range(3)]
+        accel[2] -= self.gravity
+        _, inverse = pybullet.invertTransform((0, 0, 0), pose[1])
+        local_w, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, angular, (0, 0, 0, 1))
+        local_a, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, accel, (0, 0, 0, 1))
+        return pose, tuple(local_w), tuple(local_a), linear
 
     def set_planar_velocity(self, vx, vy, wz):
         """Holonomic body velocity (gazebo_ros_planar_move): ``vx, vy`` [m/s] in the base frame's heading,

@@ -11,10 +11,10 @@ purpose: genpy reads ``self.__slots__`` for the field list (printing, equality, 
 """
 import struct
 
-from geometry_msgs.msg import TransformStamped, Twist, TwistStamped
+from geometry_msgs.msg import TransformStamped, Twist, TwistStamped, Vector3Stamped
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import Imu, JointState
+from sensor_msgs.msg import Imu, JointState, NavSatFix
 from tf2_msgs.msg import TFMessage
 
 _HEADER = struct.Struct("<3I")  # seq, stamp.secs, stamp.nsecs
@@ -137,6 +137,49 @@ class PackedTFMessage(TFMessage):
             transform.serialize(buff)
 
 
+from sensor_msgs.msg import CameraInfo, Image, PointCloud2, PointField  # noqa: E402  (cameras' builders)
+
+
+class ImageBuilder:
+    """sensor_msgs/Image of a fixed size and encoding in ``frame``; ``build`` refills its data (bytes)."""
+
+    def __init__(self, frame, width, height, encoding, bytes_per_pixel):
+        self.msg = Image(height=height, width=width, encoding=encoding, is_bigendian=0,
+                         step=width * bytes_per_pixel)
+        self.msg.header.frame_id = frame
+
+    def build(self, stamp, data):
+        self.msg.header.stamp = stamp
+        self.msg.data = data
+        return self.msg
+
+
+def camera_info(frame, intrinsics):
+    """sensor_msgs/CameraInfo from :class:`diffbot_sim.camera_sensor.Intrinsics` (set its stamp per image)."""
+    msg = CameraInfo(height=intrinsics.height, width=intrinsics.width,
+                     distortion_model=intrinsics.distortion_model, D=list(intrinsics.D), K=list(intrinsics.K),
+                     R=list(intrinsics.R), P=list(intrinsics.P))
+    msg.header.frame_id = frame
+    return msg
+
+
+class PointCloudBuilder:
+    """An organised sensor_msgs/PointCloud2 (``fields``: (name, byte offset) of FLOAT32 values)."""
+
+    def __init__(self, frame, width, height, fields, point_step):
+        self.msg = PointCloud2(height=height, width=width, is_bigendian=False, point_step=point_step,
+                               row_step=point_step * width, is_dense=False,
+                               fields=[PointField(name=n, offset=o, datatype=PointField.FLOAT32, count=1)
+                                       for n, o in fields])
+        self.msg.header.frame_id = frame
+
+    def build(self, stamp, data, dense=False):
+        self.msg.header.stamp = stamp
+        self.msg.data = data
+        self.msg.is_dense = dense
+        return self.msg
+
+
 def tf_message(transforms):
     """All of a step's transforms in one TFMessage (one publish, not one per frame)."""
     return PackedTFMessage(transforms=list(transforms))
@@ -187,7 +230,55 @@ def imu(stamp, frame, orientation, angular_velocity, linear_acceleration, covari
     a.x, a.y, a.z = linear_acceleration
     for field_name, value in zip(("orientation_covariance", "angular_velocity_covariance",
                                   "linear_acceleration_covariance"), covariance):
-        setattr(msg, field_name, [value, 0.0, 0.0, 0.0, value, 0.0, 0.0, 0.0, value])
+        setattr(msg, field_name, covariance3(value))
+    return msg
+
+
+def covariance3(value):
+    """A 3x3 row-major covariance from one number (the whole diagonal), three (the diagonal) or nine."""
+    if isinstance(value, (int, float)):
+        value = (value,) * 3
+    value = [float(v) for v in value]
+    if len(value) == 9:
+        return value
+    return [value[0], 0.0, 0.0, 0.0, value[1], 0.0, 0.0, 0.0, value[2]]
+
+
+def nav_sat_fix(stamp, frame, latitude, longitude, altitude, covariance=None, status=0, service=1):
+    """sensor_msgs/NavSatFix [deg, deg, m]; ``covariance`` (three diagonal values [m^2] or nine) makes the
+    type DIAGONAL_KNOWN (or KNOWN), None UNKNOWN."""
+    msg = NavSatFix()
+    msg.header.stamp, msg.header.frame_id = stamp, frame
+    msg.status.status, msg.status.service = status, service
+    msg.latitude, msg.longitude, msg.altitude = latitude, longitude, altitude
+    if covariance is None:
+        msg.position_covariance_type = NavSatFix.COVARIANCE_TYPE_UNKNOWN
+    else:
+        msg.position_covariance = covariance3(covariance)
+        msg.position_covariance_type = (NavSatFix.COVARIANCE_TYPE_KNOWN if len(covariance) == 9
+                                        else NavSatFix.COVARIANCE_TYPE_DIAGONAL_KNOWN)
+    return msg
+
+
+def vector3_stamped(stamp, frame, vector):
+    msg = Vector3Stamped()
+    msg.header.stamp, msg.header.frame_id = stamp, frame
+    msg.vector.x, msg.vector.y, msg.vector.z = vector
+    return msg
+
+
+def odometry(stamp, frame, child, position, orientation, linear, angular, pose_covariance, twist_covariance):
+    """nav_msgs/Odometry with six-value covariance diagonals (a plain message, for sensors like p3d)."""
+    msg = Odometry()
+    msg.header.stamp, msg.header.frame_id, msg.child_frame_id = stamp, frame, child
+    p, q = msg.pose.pose.position, msg.pose.pose.orientation
+    p.x, p.y, p.z = position
+    q.x, q.y, q.z, q.w = orientation
+    v, w = msg.twist.twist.linear, msg.twist.twist.angular
+    v.x, v.y, v.z = linear
+    w.x, w.y, w.z = angular
+    msg.pose.covariance = diagonal(pose_covariance)
+    msg.twist.covariance = diagonal(twist_covariance)
     return msg
 
 
@@ -213,3 +304,93 @@ def twist_stamped(stamp, linear, angular):
 def twist_values(twist):
     """The six Twist fields in controller.TWIST_FIELDS order."""
     return (twist.linear.x, twist.linear.y, twist.linear.z, twist.angular.x, twist.angular.y, twist.angular.z)
+
+
+# -- ray sensors (diffbot_sim.plugins.laser, .range) --------------------------------------------------------
+from sensor_msgs.msg import ChannelFloat32, LaserScan, PointCloud, PointCloud2, PointField, Range  # noqa: E402
+from geometry_msgs.msg import Point32  # noqa: E402
+import numpy as np  # noqa: E402
+
+_SCAN_CONSTANTS = struct.Struct("<7f")  # angle_min, angle_max, angle_increment, time_increment, scan_time,
+# range_min, range_max
+
+
+class PackedLaserScan(LaserScan):
+    """sensor_msgs/LaserScan with its frame and the seven constant fields packed once; ``ranges`` and
+    ``intensities`` may be numpy arrays (written as float32 in one call each)."""
+
+
+    def __init__(self, frame, angle_min, angle_max, angle_increment, range_min, range_max):
+        super().__init__()
+        self.header.frame_id = frame
+        self.angle_min, self.angle_max, self.angle_increment = angle_min, angle_max, angle_increment
+        self.time_increment = self.scan_time = 0.0  # what gazebo_ros publishes ("instantaneous simulator scan")
+        self.range_min, self.range_max = range_min, range_max
+        self._constants = _string(frame) + _SCAN_CONSTANTS.pack(
+            angle_min, angle_max, angle_increment, 0.0, 0.0, range_min, range_max)
+
+    def serialize(self, buff):
+        h = self.header
+        buff.write(_HEADER.pack(h.seq, h.stamp.secs, h.stamp.nsecs))
+        buff.write(self._constants)
+        for values in (self.ranges, self.intensities):
+            buff.write(_COUNT.pack(len(values)))
+            buff.write(np.asarray(values, dtype="<f4").tobytes())
+
+
+class LaserScanBuilder:
+    """One laser's LaserScan, refilled per build (publish it before the next build)."""
+
+    def __init__(self, frame, angle_min, angle_max, angle_increment, range_min, range_max):
+        self.msg = PackedLaserScan(frame, angle_min, angle_max, angle_increment, range_min, range_max)
+
+    def build(self, stamp, ranges, intensities):
+        msg = self.msg
+        msg.header.stamp = stamp
+        msg.ranges, msg.intensities = ranges, intensities
+        return msg
+
+
+class RangeBuilder:
+    """sensor_msgs/Range of one sonar or IR sensor; ``ultrasound`` picks ULTRASOUND, else INFRARED."""
+
+    def __init__(self, frame, ultrasound, field_of_view, min_range, max_range):
+        msg = self.msg = Range()
+        msg.header.frame_id = frame
+        msg.radiation_type = Range.ULTRASOUND if ultrasound else Range.INFRARED
+        msg.field_of_view, msg.min_range, msg.max_range = field_of_view, min_range, max_range
+
+    def build(self, stamp, value):
+        self.msg.header.stamp = stamp
+        self.msg.range = value
+        return self.msg
+
+
+class PointCloud2Builder:
+    """sensor_msgs/PointCloud2 of x, y, z, intensity float32 points (height 1, dense), as gazebo_ros's
+    ROS 2 ray sensor publishes."""
+
+    def __init__(self, frame):
+        msg = self.msg = PointCloud2()
+        msg.header.frame_id = frame
+        msg.height, msg.is_bigendian, msg.is_dense, msg.point_step = 1, False, True, 16
+        msg.fields = [PointField(name=n, offset=4 * i, datatype=PointField.FLOAT32, count=1)
+                      for i, n in enumerate(("x", "y", "z", "intensity"))]
+
+    def build(self, stamp, points):
+        """``points``: (n, 4) float32 array (x, y, z, intensity)."""
+        msg = self.msg
+        msg.header.stamp = stamp
+        msg.width = len(points)
+        msg.row_step = msg.point_step * msg.width
+        msg.data = points.astype("<f4").tobytes()
+        return msg
+
+
+def point_cloud(stamp, frame, points):
+    """sensor_msgs/PointCloud of ``points`` ((n, 4): x, y, z, intensity) with one ``intensity`` channel."""
+    msg = PointCloud()
+    msg.header.stamp, msg.header.frame_id = stamp, frame
+    msg.points = [Point32(x, y, z) for x, y, z in points[:, :3].tolist()]
+    msg.channels = [ChannelFloat32(name="intensity", values=points[:, 3].tolist())]
+    return msg

@@ -52,6 +52,7 @@ class Body:
     mass: float = 1.0
     inertia: Tuple[float, float, float, float, float, float] = (1.0, 1.0, 1.0, 0.0, 0.0, 0.0)
     inertial_pose: Pose = IDENTITY
+    color: Optional[Tuple[float, float, float, float]] = None  # rgba of its first <visual>'s material
 
 
 @dataclass

@@ -12,7 +12,9 @@ What is read (SDF 1.4 to 1.9, as Gazebo 11 reads them):
   Each ``<link>`` becomes one :class:`~diffbot_sim.world.Body` named ``model::link``; joints between links
   are named in one warning per model and not simulated (the links move as separate bodies).
 * ``<collision>`` geometry box, cylinder, sphere, plane (infinite), mesh; surface ``mu``/``mu2`` (ODE, else
-  Bullet), contact ``kp``/``kd`` and ``laser_retro``. Visuals are not read.
+  Bullet), contact ``kp``/``kd`` and ``laser_retro``. Of visuals only the colour is read, for cameras: the
+  first ``<visual><material>`` of a link gives ``Body.color`` (its ``<diffuse>``, else ``<ambient>``, else a
+  ``<script><name>`` of :data:`GAZEBO_COLORS`); the camera sees the collision geometry in that colour.
 * Poses with SDF 1.7+ frame semantics (``relative_to`` naming a model, a link, ``model::link``, a ``<frame>``
   or a joint; 1.5/1.6's ``frame`` attribute is the same attribute before its rename), 1.8
   ``placement_frame``, 1.9 ``degrees`` and ``rotation_format="quat_xyzw"``.
@@ -48,11 +50,25 @@ _BUILTIN = {
     "ground_plane": """<sdf version="1.5"><model name="ground_plane"><static>true</static>
   <link name="link"><collision name="collision"><geometry><plane><normal>0 0 1</normal><size>100 100</size>
   </plane></geometry><surface><friction><ode><mu>100</mu><mu2>50</mu2></ode></friction></surface></collision>
+  <visual name="visual"><material><script><name>Gazebo/Grey</name></script></material></visual>
   </link></model></sdf>""",
     "sun": """<sdf version="1.5"><light type="directional" name="sun"><cast_shadows>true</cast_shadows>
   <pose>0 0 10 0 0 0</pose><diffuse>0.8 0.8 0.8 1</diffuse><specular>0.2 0.2 0.2 1</specular>
   <direction>-0.5 0.1 -0.9</direction></light></sdf>""",
 }
+
+#: rgba of Gazebo's stock material scripts (gazebo.material's diffuse colours; Wood and Bricks are textures
+#: there, here their average colour). Other script names leave a body uncoloured (PyBullet's default grey).
+GAZEBO_COLORS = {
+    "Gazebo/Red": (1.0, 0.0, 0.0, 1.0), "Gazebo/Green": (0.0, 1.0, 0.0, 1.0), "Gazebo/Blue": (0.0, 0.0, 1.0, 1.0),
+    "Gazebo/Grey": (0.7, 0.7, 0.7, 1.0), "Gazebo/Gray": (0.7, 0.7, 0.7, 1.0),
+    "Gazebo/DarkGrey": (0.175, 0.175, 0.175, 1.0), "Gazebo/White": (1.0, 1.0, 1.0, 1.0),
+    "Gazebo/Black": (0.0, 0.0, 0.0, 1.0), "Gazebo/Yellow": (1.0, 1.0, 0.0, 1.0),
+    "Gazebo/Orange": (1.0, 0.5088, 0.0468, 1.0), "Gazebo/Purple": (1.0, 0.0, 1.0, 1.0),
+    "Gazebo/Turquoise": (0.0, 1.0, 1.0, 1.0), "Gazebo/Wood": (0.56, 0.39, 0.22, 1.0),
+    "Gazebo/Bricks": (0.6, 0.3, 0.22, 1.0),
+}
+
 
 # World children that change nothing our physics does: named once in ``not_simulated``.
 _WORLD_NOT_SIMULATED = ("scene", "gui", "atmosphere", "magnetic_field", "spherical_coordinates", "wind",
@@ -164,6 +180,7 @@ class _Link:
         self.mass = 1.0
         self.inertia = (1.0, 1.0, 1.0, 0.0, 0.0, 0.0)
         self.inertial_pose = IDENTITY
+        self.color = None
 
 
 # ------------------------------------------------------------------------------------------ search paths
@@ -676,11 +693,35 @@ class _Reader:
             self.skip(f"sensor {sensor.get('name', '')} ({sensor.get('type', '')}) in link {full}")
         for light in el.findall("light"):
             self.skip(f"light {light.get('name', '')} ({light.get('type', 'point')}) in link {full}")
+        for visual in el.findall("visual"):
+            link.color = self.material(visual, src, f"{path}/visual[@name='{visual.get('name', '')}']")
+            if link.color is not None:
+                break
         for collision in el.findall("collision"):
             shape = self.collision(collision, src, f"{path}/collision[@name='{collision.get('name', '')}']")
             if shape is not None:
                 link.shapes.append(shape)
         return link
+
+    def material(self, el, src, path):
+        """rgba of a ``<visual>``'s ``<material>``: ``<diffuse>``, else ``<ambient>``, else a known script name."""
+        material = el.find("material")
+        if material is None:
+            return None
+        for tag in ("diffuse", "ambient"):
+            text = _text(material, tag)
+            if text is not None:
+                parts = text.split()
+                values = self.floats(text, len(parts) if len(parts) in (3, 4) else 4, src,
+                                     f"{path}/material/{tag}", f"<{tag}>")
+                return tuple(min(max(v, 0.0), 1.0) for v in values) + ((1.0,) if len(values) == 3 else ())
+        name = _text(material, "script/name")
+        if name is not None:
+            if name in GAZEBO_COLORS:
+                return GAZEBO_COLORS[name]
+            self.warn(f"{src.path}: {path}/material/script: '{name}' is not a colour this simulator knows; "
+                      f"the camera sees it grey")
+        return None
 
     def collision(self, el, src, path):
         geometry = el.find("geometry")
@@ -892,7 +933,7 @@ class _Reader:
                     mass = 1.0
                 body = Body(name=f"{model.full}::{link.name}", model=model.full, pose=_clean(pose),
                             static=static, shapes=link.shapes, mass=mass, inertia=link.inertia,
-                            inertial_pose=_clean(link.inertial_pose))
+                            inertial_pose=_clean(link.inertial_pose), color=link.color)
                 for shape in body.shapes:
                     shape.pose = _clean(shape.pose)
                 self.world.bodies.append(body)

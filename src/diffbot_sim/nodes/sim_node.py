@@ -403,6 +403,11 @@ def build(cfg, params):
         _apply_world_physics(cfg, world, params)
     sim = Simulator(cfg)
     try:
+        if cfg.renderer == "egl":  # before any body exists: the EGL plugin draws only bodies made after it
+            reason = sim.world.use_egl()
+            if reason is not None:
+                rospy.logwarn(f"~renderer egl not available ({reason}); cameras use PyBullet's TinyRenderer")
+                cfg.renderer = "tiny"
         if world is not None:
             sim.world_description = world
             sim.world.load_world(world, meshes.default_cache_dir())

@@ -3,9 +3,13 @@
 The two plugins the model reader parses itself (diff drive, joint-state publisher) are built from their
 PluginBlocks; every other one from its element by its module's ``create(ctx, element, path, params)``.
 """
-from . import diff_drive, joint_state, kobuki, planar_move, ros_control, skid_steer
+from . import diff_drive, gps, imu, joint_state, kobuki, p3d, planar_move, ros_control, skid_steer
+from .camera import create as create_camera
+from .depth import create as create_depth
 from .ground_truth import GroundTruth
 from .joint_motors import JointMotors
+from .laser import create_laser, create_ray_sensor
+from .range import create as create_range
 from .tags import DIFF_DRIVE, JOINT_STATE
 
 #: Model plugins by filename (``libNAME.so``).
@@ -14,10 +18,21 @@ MODEL_PLUGINS = {
     "libgazebo_ros_planar_move.so": planar_move.create,
     "libgazebo_ros_kobuki.so": kobuki.create,
     "libgazebo_ros_control.so": ros_control.create,
+    "libgazebo_ros_imu.so": imu.create_model,
+    "libhector_gazebo_ros_imu.so": imu.create_hector,
+    "libgazebo_ros_p3d.so": p3d.create,
+    "libhector_gazebo_ros_gps.so": gps.create,
 }
 #: Sensor plugins by filename: ``create(ctx, sensor, plugin_element, params)`` with ``sensor`` a
 #: :class:`~diffbot_sim.plugins.tags.SensorElement` (its type, link, element and path). One line per module.
 SENSOR_PLUGINS = {
+    "libgazebo_ros_imu_sensor.so": imu.create_sensor,
+    "libgazebo_ros_laser.so": create_laser,
+    "libgazebo_ros_gpu_laser.so": create_laser,
+    "libgazebo_ros_ray_sensor.so": create_ray_sensor,
+    "libgazebo_ros_range.so": create_range,
+    "libgazebo_ros_camera.so": create_camera,
+    "libgazebo_ros_openni_kinect.so": create_depth,
 }
 #: Sensors simulated without a plugin of their own, by type (``create(ctx, sensor, None, params)``).
 SENSOR_TYPES = {

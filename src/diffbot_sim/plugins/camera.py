@@ -1,0 +1,168 @@
+"""``libgazebo_ros_camera.so`` on a ``<sensor type="camera">``: ``image_raw`` (sensor_msgs/Image) and
+``camera_info`` at the sensor's ``<update_rate>`` (throttled by the plugin's ``updateRate``), stamped in sim
+time, rendered by PyBullet from the sensor's pose looking along its +x (Gazebo's convention; no optical
+rotation: ``frameName`` is published as given).
+
+Tags: ROS 1 ``robotNamespace``, ``cameraName``, ``imageTopicName`` (image_raw), ``cameraInfoTopicName``
+(camera_info), ``frameName`` (unset: ``world``, as the plugin's ``/world`` without the slash tf2 rejects),
+``updateRate``, ``hackBaseline``, ``focalLength``, ``Cx``, ``Cy``, ``CxPrime``, ``distortionK1..K3/T1/T2``
+(they only fill D); ROS 2 ``<ros><namespace>``/``<remapping>``, ``camera_name`` (default the sensor's
+name), ``frame_name`` (default the sensor's link), ``hack_baseline``. Topics are
+``<namespace>/<cameraName>/<topic>``. A ROS 2 plugin on a ``depth`` sensor is the depth camera
+(:mod:`diffbot_sim.plugins.depth`).
+
+Cost: the image is rendered only while the image topic has a subscriber (Gazebo activates the sensor on
+the first subscriber too); camera_info alone costs no rendering. ``~renderer``: ``tiny`` (default, PyBullet's
+CPU TinyRenderer) or ``egl`` (OpenGL off screen; falls back to tiny with one warning when not available).
+"""
+from sensor_msgs.msg import CameraInfo, Image
+
+from .. import camera_sensor as cam
+from .. import ros_msgs
+from ..errors import ConfigError, ModelError
+from .base import Plugin, join, next_due, publisher
+
+def choose_renderer(ctx):
+    """The renderer cameras use: ``~renderer`` (SimConfig), which the simulator set back to ``tiny`` (with
+    one warning) when the EGL plugin could not be loaded before the world was built."""
+    return ctx.cfg.renderer
+
+
+class CameraBase(Plugin):
+    """What the camera and depth plugins share: the sensor's pose, timing, rendering and CameraInfo."""
+
+    def __init__(self, ctx, sensor, cfg, tags):
+        self.ctx = ctx
+        self.sensor = sensor
+        self.cfg = cfg
+        self.tags = tags
+        self.link = sensor.link or ctx.model.root
+        try:
+            ctx.robot.link_pose(self.link)
+        except KeyError:
+            raise ModelError(f"camera sensor '{cfg.name}' is on link '{self.link}', which the model does not "
+                             "have", ctx.model.source, sensor.path) from None
+        values = tags.values
+        self.intrinsics = cam.intrinsics(
+            cfg.width, cfg.height, cfg.hfov, cx=values.get("cx", 0.0), cy=values.get("cy", 0.0),
+            cx_prime=values.get("cx_prime", 0.0), focal=values.get("focal_length", 0.0),
+            hack_baseline=values.get("hack_baseline", 0.0),
+            distortion=tuple(values.get(k, 0.0) for k in ("k1", "k2", "k3", "t1", "t2")))
+        for text in cfg.warnings + [f"{sensor.path}: {w}" for w in self.intrinsics.warnings]:
+            ctx.warnings.append(text)
+        if tags.unknown:
+            ctx.warnings.append(f"{sensor.path}: unknown camera plugin tags ignored: {', '.join(tags.unknown)}")
+        self.period = cam.effective_period(cfg.update_rate, values.get("update_rate", 0.0))
+        if self.period == 0.0:
+            ctx.warnings.append(f"{sensor.path}: <update_rate> 0 renders at every physics step (costly); "
+                                "give the sensor a rate")
+        self.renderer = choose_renderer(ctx)
+        self.next = 0.0
+        self.frame = ctx.frame(self._frame_name())
+        self.rng = None
+        if cfg.noise_mean or cfg.noise_stddev:
+            import zlib
+
+            import numpy as np
+            self.rng = np.random.default_rng([int(ctx.params.get("seed", 0)) & 0xFFFFFFFF,
+                                              zlib.crc32(cfg.name.encode("utf-8"))])
+        self.renders = 0  # images rendered (for tests and figures)
+
+    def _frame_name(self):
+        frame = self.tags.values.get("frame")
+        if frame:
+            return self.ctx.clean_frame(frame, f"{self.sensor.path}/plugin frameName")
+        if self.tags.dialect == "ros2":
+            return self.link
+        self.ctx.warnings.append(f"{self.sensor.path}: no frameName; images are in 'world' (Gazebo: '/world')")
+        return "world"
+
+    def namespace(self):
+        """The topics' namespace: ``<robotNamespace>/<cameraName>`` (ROS 1) or ``<ros><namespace>`` (ROS 2)."""
+        ns = self.ctx.plugin_namespace(self.tags.values.get("namespace") or None)
+        if self.tags.dialect == "ros1":
+            name = self.tags.values.get("camera_name") or ""
+            return join(ns, name) if name else ns
+        return ns
+
+    def topic(self, key, default):
+        """A topic from its tag (ROS 1) or ``<camera_name>/<default>`` after remapping (ROS 2)."""
+        ns = self.namespace()
+        if self.tags.dialect == "ros1":
+            return join(ns, self.tags.values.get(key) or default)
+        name = f"{self.tags.values.get('camera_name') or self.cfg.name}/{default}"
+        out = cam.remapped(self.tags, name)
+        out = cam.remapped(self.tags, default) if out == name else out
+        return join(ns, out)
+
+    def next_publish(self):
+        return self.next
+
+    def view_pose(self):
+        return cam.sensor_view(self.ctx.robot.link_pose(self.link), self.cfg.pose)
+
+    def render(self):
+        cfg = self.cfg
+        rgb, depth = self.ctx.sim.world.render(self.view_pose(), cfg.width, cfg.height, cfg.hfov, cfg.near,
+                                               cfg.far, self.renderer)
+        self.renders += 1
+        if self.rng is not None:
+            rgb = cam.image_noise(rgb, cfg.noise_mean, cfg.noise_stddev, self.rng)
+        return rgb, depth
+
+    def due(self, now):
+        if now + 1e-9 < self.next:
+            return False
+        self.next = next_due(self.next, self.period, now)
+        return True
+
+    def summary(self):
+        return {f"camera/{self.cfg.name}": cam.describe(self.cfg, self.renderer)}
+
+
+class Camera(CameraBase):
+    filename = "libgazebo_ros_camera.so"
+
+    def __init__(self, ctx, sensor, cfg, tags):
+        super().__init__(ctx, sensor, cfg, tags)
+        self.image_pub = publisher(self.topic("image_topic", "image_raw"), Image)
+        self.info_pub = publisher(self.topic("info_topic", "camera_info"), CameraInfo)
+        channels = 1 if cfg.encoding == "mono8" else 3
+        self.image = ros_msgs.ImageBuilder(self.frame, cfg.width, cfg.height, cfg.encoding, channels)
+        self.info = ros_msgs.camera_info(self.frame, self.intrinsics)
+
+    def publishers(self):
+        return [self.image_pub, self.info_pub]
+
+    def after_step(self, now, stamp, transforms):
+        if not self.due(now):
+            return
+        if self.image_pub.get_num_connections():
+            rgb, _ = self.render()
+            self.image_pub.publish(self.image.build(stamp, cam.to_encoding(rgb, self.cfg.encoding).tobytes()))
+        if self.info_pub.get_num_connections():
+            self.info.header.stamp = stamp
+            self.info_pub.publish(self.info)
+
+    def summary(self):
+        out = super().summary()
+        out[f"camera/{self.cfg.name}/image_topic"] = self.image_pub.resolved_name
+        return out
+
+
+def create(ctx, sensor, plugin_element, params):
+    """The camera of ``sensor`` (a SensorElement), or its depth camera for a ROS 2 plugin on a depth sensor.
+
+    Raises:
+        ConfigError: a value that cannot be used. ModelError: the sensor's link is not in the model.
+    """
+    if sensor.type not in cam.CAMERA_TYPES:
+        ctx.warnings.append(f"{sensor.path}: libgazebo_ros_camera.so on a '{sensor.type}' sensor: simulated "
+                            "as a plain camera")
+    cfg = cam.parse_sensor(sensor.element, sensor.path, sensor.name)
+    tags = cam.read_plugin(plugin_element, sensor.path)
+    if sensor.type == "depth":
+        from .depth import DepthCamera
+        tags.dialect = "ros2"
+        return DepthCamera(ctx, sensor, cfg, tags)
+    return Camera(ctx, sensor, cfg, tags)

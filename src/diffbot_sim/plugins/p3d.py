@@ -1,0 +1,117 @@
+"""``libgazebo_ros_p3d.so``: nav_msgs/Odometry of a body (a URDF link, lumped or not) in the world or in
+another link's frame, as gazebo_plugins' GazeboRosP3D publishes it (sensors.md §5).
+
+Tags: ``bodyName`` and ``topicName`` (both required), ``frameName`` (``world``; a link name makes pose and
+twist relative to that link), ``xyzOffset``/``rpyOffset`` (the position is shifted and the orientation
+left-multiplied, in the reference frame), ``gaussianNoise`` (N(0, sigma) on each twist component, and sigma²
+on both covariance diagonals), ``updateRate`` (0: every step), ``robotNamespace``. Lazy.
+``child_frame_id`` is ``bodyName``. As the original, the twist is in the reference frame's axes (world by
+default), not in the child frame nav_msgs asks for. Gazebo cannot find a link that URDF→SDF lumped away;
+here a lumped link works too.
+"""
+from nav_msgs.msg import Odometry
+
+from .. import noise, ros_msgs
+from ..config import _number
+from ..errors import ModelError
+from .base import Plugin, join, next_due, publisher
+from .imu import qconj, qmul, qnormalize, qrotate, quaternion_from_rpy, read_tags, vector
+
+FILENAME = "libgazebo_ros_p3d.so"
+WORLD_FRAMES = ("world", "/world", "map", "/map", "")
+KNOWN = {"bodyName", "topicName", "frameName", "xyzOffset", "xyzOffsets", "rpyOffset", "rpyOffsets",
+         "gaussianNoise", "updateRate", "robotNamespace", "alwaysOn"}
+
+
+def settings(tags, where):
+    """{body, topic, frame, xyz, rpy, gaussian_noise, period} from the plugin's tags (pure)."""
+    for tag in ("bodyName", "topicName"):
+        if not tags.get(tag):
+            raise ModelError(f"the p3d plugin needs <{tag}> (it refuses to load without it)", None, where)
+    rate = _number(f"<updateRate> of {where}", tags.get("updateRate", 0.0), low=0.0)
+    xyz = next((vector(tags[t], where, t) for t in ("xyzOffset", "xyzOffsets") if t in tags), (0.0, 0.0, 0.0))
+    rpy = next((vector(tags[t], where, t) for t in ("rpyOffset", "rpyOffsets") if t in tags), (0.0, 0.0, 0.0))
+    return {"body": tags["bodyName"], "topic": tags["topicName"], "frame": tags.get("frameName", "world"),
+            "xyz": xyz, "rpy": rpy, "namespace": tags.get("robotNamespace"),
+            "gaussian_noise": _number(f"<gaussianNoise> of {where}", tags.get("gaussianNoise", 0.0), low=0.0),
+            "period": 1.0 / rate if rate > 0 else 0.0}
+
+
+def relative(body, reference):
+    """Pose and twist of ``body`` relative to ``reference`` (each ((p, q), v, w), world values), in the
+    reference's axes; None for the world (pure)."""
+    (p, q), v, w = body
+    if reference is None:
+        return (p, q), v, w
+    (rp, rq), rv, rw = reference
+    inv = qconj(rq)
+    return ((qrotate(inv, [p[i] - rp[i] for i in range(3)]), qnormalize(qmul(inv, q))),
+            qrotate(inv, [v[i] - rv[i] for i in range(3)]), qrotate(inv, [w[i] - rw[i] for i in range(3)]))
+
+
+class P3D(Plugin):
+    filename = FILENAME
+
+    def __init__(self, ctx, values, path, generator):
+        self.ctx, self.v, self.rng = ctx, values, generator
+        self.reference = None if values["frame"] in WORLD_FRAMES else values["frame"]
+        for link in (values["body"], self.reference):
+            if link is None:
+                continue
+            try:
+                ctx.robot.link_motion(link)
+            except KeyError:
+                raise ModelError(f"p3d: '{link}' is not a link of the model", ctx.model.source, path) from None
+        self.offset_rot = quaternion_from_rpy(*values["rpy"])
+        ns = ctx.plugin_namespace(values["namespace"])
+        self.pub = publisher(join(ns, values["topic"]), Odometry)
+        frame = ctx.clean_frame(values["frame"], path) or "world"
+        self.frame_id = frame if self.reference is None else ctx.frame(frame)
+        self.child = ctx.frame(ctx.clean_frame(values["body"], path))
+        gn2 = values["gaussian_noise"] ** 2
+        self.covariance = (gn2,) * 6
+        self.next = 0.0
+
+    def publishers(self):
+        return [self.pub]
+
+    def next_publish(self):
+        return self.next
+
+    def start(self, now):
+        self.next = now
+
+    def after_step(self, now, stamp, transforms):
+        if now + 1e-9 < self.next:
+            return
+        self.next = next_due(self.next, self.v["period"], now)
+        if not self.pub.get_num_connections():
+            return
+        robot = self.ctx.robot
+        body = robot.link_motion(self.v["body"])
+        reference = robot.link_motion(self.reference) if self.reference is not None else None
+        (p, q), v, w = relative(body, reference)
+        p = tuple(p[i] + self.v["xyz"][i] for i in range(3))
+        q = qnormalize(qmul(self.offset_rot, q))
+        sigma = self.v["gaussian_noise"]
+        if sigma > 0:
+            v = tuple(x + self.rng.gauss(0.0, sigma) for x in v)
+            w = tuple(x + self.rng.gauss(0.0, sigma) for x in w)
+        self.pub.publish(ros_msgs.odometry(stamp, self.frame_id, self.child, p, q, v, w, self.covariance,
+                                           self.covariance))
+
+    def summary(self):
+        rate = f"{round(1.0 / self.v['period'], 3)} Hz" if self.v["period"] > 0 else "every step"
+        return {f"p3d {self.pub.resolved_name}": f"body {self.v['body']}, frame {self.frame_id}, {rate}"}
+
+
+def create(ctx, element, path, params):
+    tags = read_tags(element)
+    try:
+        values = settings(tags, path)
+    except ModelError as err:
+        raise ModelError(str(err), ctx.model.source) from None
+    unknown = sorted(set(tags) - KNOWN)
+    if unknown:
+        ctx.warnings.append(f"{path}: unknown tags ignored: {', '.join(unknown)}")
+    return P3D(ctx, values, path, noise.rng(params.get("seed", 0), element.get("name") or path))

@@ -1,0 +1,73 @@
+"""``libgazebo_ros_range.so`` (ROS 1, on a ``<sensor type="ray">``): sonar and IR rangers -> sensor_msgs/Range.
+
+As gazebo_ros_range does (sensors.md §5): ``range`` is the minimum over all the sensor's raw rays (its h x v
+samples make the cone; ``fov`` is only published), a ray without a hit counting as ``range_max``; Gaussian
+noise (``gaussianNoise``, mean 0) only when that minimum is below ``range_max``, then at most ``range_max``.
+So no return reads ``range_max``, never inf. The SDF ``<ray><noise>`` does not apply (the plugin reads the
+raw rays).
+
+Tags (defaults): ``robotNamespace``; ``topicName`` (``/range``); ``frameName`` (here the sensor's link, with a
+warning; gazebo_ros says ``/world``); ``radiation`` (``ultrasound``, anything else INFRARED); ``fov``
+(0.05 rad); ``gaussianNoise`` (0 m); ``updateRate`` (0: each sensor update; else at most one reading per
+``1/updateRate`` s of the sensor's updates, the sensor's own rate being ``<update_rate>``).
+"""
+from .. import ray_sensor, ros_msgs
+from ..config import _number, _string
+from .base import join, publisher
+from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_namespace
+
+from sensor_msgs.msg import Range as RangeMsg
+
+_READ = ("robotNamespace", "topicName", "frameName", "radiation", "fov", "gaussianNoise", "updateRate")
+
+
+class RangeSensor(RaySensorPlugin):
+    filename = "libgazebo_ros_range.so"
+
+    def __init__(self, ctx, sensor, element, path, topic, frame, ultrasound, fov, stddev, update_rate):
+        super().__init__(ctx, sensor, element, path)
+        self.frame = frame
+        self.stddev = stddev
+        self.throttle = 1.0 / update_rate if update_rate > 0 else 0.0
+        self.last = None
+        self.pub = publisher(topic, RangeMsg)
+        self.builder = ros_msgs.RangeBuilder(frame, ultrasound, fov, self.cfg.range_min, self.cfg.range_max)
+
+    def publish(self, now, stamp):
+        if self.last is not None and now - self.last < self.throttle - 1e-9:
+            return
+        self.last = now
+        fractions, _ = self.cast()
+        raw = ray_sensor.raw_ranges(fractions, self.cfg.range_min, self.cfg.range_max)
+        value = ray_sensor.sonar_range(raw, self.cfg.range_max, self.stddev, self.rng)
+        self.pub.publish(self.builder.build(stamp, value))
+
+    def reset(self, now):
+        self.last = None
+
+    def summary(self):
+        return self.describe(self.pub.resolved_name, self.frame)
+
+
+def create(ctx, sensor, element, params):
+    path = _plugin_path(sensor, element)
+    _check_type(sensor, path)
+    values = plugin_tags(element)
+    ignored = [t for t in values if t not in _READ]
+    if ignored:
+        ctx.warnings.append(f"{path}: tags ignored (gazebo_ros_range does not read them): {', '.join(ignored)}")
+    ns = ros1_namespace(ctx, values)
+    topic = _string(f"<topicName> of {path}", values["topicName"]) if "topicName" in values else "/range"
+    if "frameName" in values:
+        frame = _string(f"<frameName> of {path}", values["frameName"])
+    else:
+        frame = sensor.link or "world"
+        ctx.warnings.append(f"{path}: no <frameName>: using the sensor's link '{frame}' (gazebo_ros would "
+                            "say /world)")
+    frame = ctx.frame(ctx.clean_frame(frame, path))
+    ultrasound = values.get("radiation", "ultrasound").strip() == "ultrasound"
+    fov = _number(f"<fov> of {path}", values["fov"], low=0.0) if "fov" in values else 0.05
+    stddev = _number(f"<gaussianNoise> of {path}", values["gaussianNoise"], low=0.0) \
+        if "gaussianNoise" in values else 0.0
+    rate = _number(f"<updateRate> of {path}", values["updateRate"], low=0.0) if "updateRate" in values else 0.0
+    return RangeSensor(ctx, sensor, element, path, join(ns, topic), frame, ultrasound, fov, stddev, rate)
