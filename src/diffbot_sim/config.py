@@ -40,6 +40,7 @@ class SimConfig:
     yaw: float = 0.0  # rad
     world: str = ""  # an SDF .world file or a map_server .yaml; empty: a ground plane only (also ~world_name)
     map_wall_height: float = 1.0  # m, height of the walls a map image's occupied cells become
+    seed: int = 0  # sensor noise: with the sensor's name it seeds each generator, so two runs are identical
     renderer: str = "tiny"  # cameras: tiny (PyBullet's TinyRenderer, CPU) or egl (OpenGL via EGL, if it loads)
     debug_cmd_applied: bool = False  # publish ~debug/cmd_applied (wall time a command reached the motors)
     publish_ground_truth: bool = False  # publish ~ground_truth (physics pose, like Gazebo's p3d plugin)
@@ -167,6 +168,10 @@ def sim_config(params):
         cfg.world = params["world_name"]  # gazebo_ros's empty_world.launch calls it world_name
     cfg.world = _string(name("world"), cfg.world, allow_empty=True)
     cfg.map_wall_height = _number(name("map_wall_height"), cfg.map_wall_height, low=0.0, low_open=True)
+    seed = _number(name("seed"), cfg.seed)
+    if seed != int(seed):
+        raise ConfigError(name("seed"), params.get("seed"), "an integer")
+    cfg.seed = int(seed)
     cfg.renderer = _string(name("renderer"), cfg.renderer).lower()
     if cfg.renderer not in ("tiny", "egl"):
         raise ConfigError(name("renderer"), cfg.renderer, "tiny or egl")

@@ -356,3 +356,17 @@ def test_unmatched_odometry_source_warns_and_uses_world(parse, make_urdf, text):
     cfg = drive_config(model, read_plugins(model).diff_drive, {}, notes)
     assert cfg.odometry_source == "world"
     assert len(notes) == 1 and "<odometrySource>" in notes[0] and text in notes[0]
+
+
+@pytest.mark.parametrize("params, ok", [({"seed": 7}, True), ({"seed": 1.5}, False), ({"seed": "x"}, False),
+                                        ({"renderer": "EGL"}, True), ({"renderer": "opengl"}, False)])
+def test_seed_and_renderer_are_validated_once(params, ok):
+    from diffbot_sim.config import sim_config
+
+    if ok:
+        cfg = sim_config(params)
+        assert cfg.seed == params.get("seed", 0) and cfg.renderer == params.get("renderer", "tiny").lower()
+    else:
+        with pytest.raises(ConfigError) as err:
+            sim_config(params)
+        assert f"~{next(iter(params))}" in str(err.value)

@@ -381,7 +381,10 @@ class _Ctx:
     def __init__(self, model, namespace=None, params=None):
         from diffbot_sim.plugins.base import RobotContext
 
+        from diffbot_sim.config import sim_config
+
         self.model, self.namespace, self.params = model, namespace, params or {}
+        self.cfg = sim_config(self.params)
         self.warnings = []
         self.spec = type("Spec", (), {"name": "", "tf_prefix": None})()
         self.frame = lambda name: name

@@ -64,7 +64,7 @@ class CameraBase(Plugin):
             import zlib
 
             import numpy as np
-            self.rng = np.random.default_rng([int(ctx.params.get("seed", 0)) & 0xFFFFFFFF,
+            self.rng = np.random.default_rng([ctx.cfg.seed & 0xFFFFFFFF,
                                               zlib.crc32(cfg.name.encode("utf-8"))])
         self.renders = 0  # images rendered (for tests and figures)
 

@@ -157,7 +157,7 @@ class Gps(Plugin):
 
 def create(ctx, element, path, params):
     tags = read_tags(element)
-    generator = noise.rng(params.get("seed", 0), element.get("name") or path)
+    generator = noise.rng(ctx.cfg.seed, element.get("name") or path)
     try:
         values = settings(tags, path, ctx.model.root, generator)
     except ModelError as err:

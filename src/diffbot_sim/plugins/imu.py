@@ -453,19 +453,19 @@ def _wrap(ctx, fn, *args):
 
 def create_sensor(ctx, sensor, plugin, params):
     """``<sensor type="imu">`` + libgazebo_ros_imu_sensor.so."""
-    settings = _wrap(ctx, sensor_settings, sensor, plugin, params.get("seed", 0), sensor.path)
+    settings = _wrap(ctx, sensor_settings, sensor, plugin, ctx.cfg.seed, sensor.path)
     return ImuPlugin(ctx, settings, SENSOR_FILENAME, sensor.path)
 
 
 def create_model(ctx, element, path, params):
     """The model plugin libgazebo_ros_imu.so."""
-    settings = _wrap(ctx, model_settings, element, params.get("seed", 0), path, element.get("name") or path)
+    settings = _wrap(ctx, model_settings, element, ctx.cfg.seed, path, element.get("name") or path)
     return ImuPlugin(ctx, settings, MODEL_FILENAME, path)
 
 
 def create_hector(ctx, element, path, params):
     """The model plugin libhector_gazebo_ros_imu.so."""
-    settings = _wrap(ctx, hector_settings, element, params.get("seed", 0), path, element.get("name") or path,
+    settings = _wrap(ctx, hector_settings, element, ctx.cfg.seed, path, element.get("name") or path,
                      ctx.model.root)
     return ImuPlugin(ctx, settings, HECTOR_FILENAME, path)
 

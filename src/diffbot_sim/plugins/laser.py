@@ -40,11 +40,8 @@ def plugin_tags(element):
 
 
 def sensor_seed(ctx, where):
-    """The noise seed: the simulator's ``~seed`` parameter (default 0), so two runs are identical."""
-    seed = ctx.params.get("seed", 0)
-    if isinstance(seed, bool) or not isinstance(seed, int):
-        raise ConfigError("~seed", seed, f"an integer (the noise seed of {where})")
-    return seed
+    """The noise seed: the simulator's ``~seed`` (validated in SimConfig), so two runs are identical."""
+    return ctx.cfg.seed
 
 
 def ros1_namespace(ctx, values):

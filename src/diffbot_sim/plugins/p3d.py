@@ -114,4 +114,4 @@ def create(ctx, element, path, params):
     unknown = sorted(set(tags) - KNOWN)
     if unknown:
         ctx.warnings.append(f"{path}: unknown tags ignored: {', '.join(unknown)}")
-    return P3D(ctx, values, path, noise.rng(params.get("seed", 0), element.get("name") or path))
+    return P3D(ctx, values, path, noise.rng(ctx.cfg.seed, element.get("name") or path))
