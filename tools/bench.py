@@ -17,6 +17,10 @@ Items (issue 9):
              with an empty mesh cache and with the cache filled; median of 3 each.
   ros_control  fast-mode RTF of the four-wheel ros_control fixture (diff_drive_controller from its YAML),
              its odom, /joint_states and /tf each subscribed by a process of its own; median of 3.
+Items (issue 11):
+  sensors    a robot with a 360-beam laser at 5 Hz and an IMU at 100 Hz, both subscribed (with /odom and
+             /tf), in worlds/room.world: fast-mode RTF (median of 3) and real-time simulator CPU (30 s).
+             Cameras: tools/camera_speed.py.
 Items (issue 10):
   worlds     roslaunch -> first /odom in a world of 30 models with COLLADA collision meshes (empty mesh
              cache), and with a 4000 x 4000 map image (a floor plan, and the same with 2 % speckle);
@@ -465,6 +469,45 @@ DAE = """<?xml version="1.0"?>
 """
 
 
+def sensor_robot():
+    """tests/data/robots/laser_robot.urdf with its IMU given libgazebo_ros_imu_sensor.so at 100 Hz."""
+    with open(os.path.join(ROOT, "tests", "data", "robots", "laser_robot.urdf")) as f:
+        text = f.read()
+    plain = '<sensor type="imu" name="imu"><always_on>true</always_on><update_rate>100</update_rate></sensor>'
+    if plain not in text:
+        raise RuntimeError("laser_robot.urdf changed: its plugin-less imu sensor is gone")
+    text = text.replace(plain, plain.replace("</sensor>", '<plugin name="imu_plugin" filename="libgazebo_ros_imu_sensor'
+                                             '.so"><topicName>imu</topicName><frameName>imu_link</frameName>'
+                                             "<updateRateHZ>100.0</updateRateHZ></plugin></sensor>"))
+    os.makedirs(RESULTS, exist_ok=True)
+    path = os.path.join(RESULTS, "sensor_robot.urdf")
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+def bench_sensors(runs, seconds, realtime_seconds):
+    """Laser (360 beams, 5 Hz) + IMU (100 Hz), both subscribed, in the example world."""
+    model, world = sensor_robot(), os.path.join(ROOT, "worlds", "room.world")
+    args = (f"model:={model}", f"world:={world}", "robot_state_publisher:=false", "x:=-1.0")
+    topics = ["/scan", "/imu", "/odom", "/tf"]
+    rtfs, trials = [], []
+    for _ in range(runs):
+        with Launch(sim_args("real_time:=false", *args), "sensors_fast") as launch:
+            for topic in topics:
+                subscriber(launch, [topic])
+            trial = launch.probe("rtf", seconds=seconds, warmup=3.0)
+            trial["subscriber_messages"] = {k: v for c in launch.stop_children() if c for k, v in c.items()}
+        rtfs.append(trial["rtf"])
+        trials.append(trial)
+    with Launch(sim_args(*args), "sensors_realtime") as launch:
+        for topic in topics:
+            subscriber(launch, [topic])
+        realtime = launch.probe("rtf", seconds=realtime_seconds, warmup=3.0, timeout=realtime_seconds + 120)
+    fast = dict(trials[rtfs.index(statistics.median_low(rtfs))], rtf=statistics.median(rtfs), rtf_runs=rtfs)
+    return {"fast": fast, "realtime": realtime}
+
+
 def mesh_world(models=30, segments=64):
     """A world of ``models`` static models, each a cylinder-ish COLLADA mesh (mm units) of its own file."""
     import math
@@ -616,6 +659,11 @@ def table(r):
         rows += [(f"first /odom, {m['stl_bytes'] / 1e6:.1f} MB STL, empty mesh cache", f"{m['cold']['median_s']:.2f} s",
                   "<= 2 s"),
                  ("  same, mesh cache filled", f"{m['cached']['median_s']:.2f} s", "")]
+    if r.get("sensors"):
+        se = r["sensors"]
+        rows += [("fast-mode RTF, laser 360 beams @5 Hz + IMU @100 Hz subscribed, room.world", f"{se['fast']['rtf']:.1f}",
+                  ">= 30"),
+                 ("  the same in real time: simulator CPU", f"{se['realtime']['cpu_percent']:.1f} % of a core", "<= 15 %")]
     if r.get("worlds"):
         w = r["worlds"]
         rows += [("first /odom, world of 30 COLLADA mesh models (empty cache)", f"{w['mesh_world']['median_s']:.2f} s",
@@ -643,7 +691,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--probe", choices=sorted(PROBES), help=argparse.SUPPRESS)
     parser.add_argument("--options", default="{}", help=argparse.SUPPRESS)
-    parser.add_argument("--only", default="fast,realtime,latency,startup,scale,meshes,ros_control,worlds",
+    parser.add_argument("--only", default="fast,realtime,latency,startup,scale,meshes,ros_control,worlds,sensors",
                         help="comma-separated items to run (default: all)")
     parser.add_argument("--quick", action="store_true", help="shorter windows (smoke run, not for figures)")
     args = parser.parse_args()
@@ -660,7 +708,8 @@ def main():
              ("scale_rsp", lambda: bench_scale(4 if q else 8, True)),
              ("meshes", lambda: bench_meshes(1 if q else 3)),
              ("ros_control", lambda: bench_ros_control(4 if q else 12, 1 if q else 3)),
-             ("worlds", lambda: bench_worlds(1 if q else 3, 4 if q else 10))]
+             ("worlds", lambda: bench_worlds(1 if q else 3, 4 if q else 10)),
+             ("sensors", lambda: bench_sensors(1 if q else 3, 4 if q else 10, 10 if q else 30))]
     for name, run in steps:
         wanted = name in items or (name == "scale_rsp" and "scale" in items)
         if not wanted:
