@@ -11,10 +11,13 @@ purpose: genpy reads ``self.__slots__`` for the field list (printing, equality, 
 """
 import struct
 
-from geometry_msgs.msg import TransformStamped, Twist, TwistStamped, Vector3Stamped
+import numpy as np
+
+from geometry_msgs.msg import Point32, TransformStamped, Twist, TwistStamped, Vector3Stamped
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import Imu, JointState, NavSatFix
+from sensor_msgs.msg import (CameraInfo, ChannelFloat32, Image, Imu, JointState, LaserScan, NavSatFix, PointCloud,
+                             PointCloud2, PointField, Range)
 from tf2_msgs.msg import TFMessage
 
 _HEADER = struct.Struct("<3I")  # seq, stamp.secs, stamp.nsecs
@@ -137,7 +140,6 @@ class PackedTFMessage(TFMessage):
             transform.serialize(buff)
 
 
-from sensor_msgs.msg import CameraInfo, Image, PointCloud2, PointField  # noqa: E402  (cameras' builders)
 
 
 class ImageBuilder:
@@ -307,9 +309,6 @@ def twist_values(twist):
 
 
 # -- ray sensors (diffbot_sim.plugins.laser, .range) --------------------------------------------------------
-from sensor_msgs.msg import ChannelFloat32, LaserScan, PointCloud, PointCloud2, PointField, Range  # noqa: E402
-from geometry_msgs.msg import Point32  # noqa: E402
-import numpy as np  # noqa: E402
 
 _SCAN_CONSTANTS = struct.Struct("<7f")  # angle_min, angle_max, angle_increment, time_increment, scan_time,
 # range_min, range_max
@@ -387,10 +386,42 @@ class PointCloud2Builder:
         return msg
 
 
-def point_cloud(stamp, frame, points):
-    """sensor_msgs/PointCloud of ``points`` ((n, 4): x, y, z, intensity) with one ``intensity`` channel."""
+class RingCloudBuilder:
+    """sensor_msgs/PointCloud2 as velodyne_simulator's plugin publishes it: x, y, z, intensity (float32),
+    ring (uint16: the laser's row, 0 the lowest), time (float32, 0 here: the scan is instantaneous)."""
+
+    RECORD = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("intensity", "<f4"), ("ring", "<u2"),
+                       ("time", "<f4")])
+
+    def __init__(self, frame):
+        msg = self.msg = PointCloud2()
+        msg.header.frame_id = frame
+        msg.is_bigendian, msg.point_step = False, self.RECORD.itemsize
+        msg.fields = [PointField(name=n, offset=self.RECORD.fields[n][1],
+                                 datatype=PointField.UINT16 if n == "ring" else PointField.FLOAT32, count=1)
+                      for n in self.RECORD.names]
+
+    def build(self, stamp, points, rings, height=1, dense=True):
+        """``points``: (n, 4) x, y, z, intensity; ``rings``: (n,) row of each point. ``height`` > 1: an
+        organised cloud of that many rows (NaN points where a ray returned nothing)."""
+        msg = self.msg
+        msg.header.stamp = stamp
+        data = np.zeros(len(points), self.RECORD)
+        for i, name in enumerate(("x", "y", "z", "intensity")):
+            data[name] = points[:, i]
+        data["ring"] = rings
+        msg.height, msg.width = height, len(points) // max(height, 1)
+        msg.is_dense = dense
+        msg.row_step = msg.point_step * msg.width
+        msg.data = data.tobytes()
+        return msg
+
+
+def point_cloud(stamp, frame, points, channel="intensity"):
+    """sensor_msgs/PointCloud of ``points`` ((n, 4): x, y, z, intensity) with one channel of that name
+    (gazebo_ros_block_laser's is unnamed)."""
     msg = PointCloud()
     msg.header.stamp, msg.header.frame_id = stamp, frame
     msg.points = [Point32(x, y, z) for x, y, z in points[:, :3].tolist()]
-    msg.channels = [ChannelFloat32(name="intensity", values=points[:, 3].tolist())]
+    msg.channels = [ChannelFloat32(name=channel, values=points[:, 3].tolist())]
     return msg

@@ -3,7 +3,7 @@
 The two plugins the model reader parses itself (diff drive, joint-state publisher) are built from their
 PluginBlocks; every other one from its element by its module's ``create(ctx, element, path, params)``.
 """
-from . import diff_drive, gps, imu, joint_state, kobuki, p3d, planar_move, ros_control, skid_steer
+from . import diff_drive, gps, imu, joint_state, kobuki, p3d, planar_move, ray_clouds, ros_control, skid_steer
 from .camera import create as create_camera
 from .depth import create as create_depth
 from .ground_truth import GroundTruth
@@ -31,6 +31,9 @@ SENSOR_PLUGINS = {
     "libgazebo_ros_gpu_laser.so": create_laser,
     "libgazebo_ros_ray_sensor.so": create_ray_sensor,
     "libgazebo_ros_range.so": create_range,
+    "libgazebo_ros_block_laser.so": ray_clouds.create_block,
+    "libgazebo_ros_velodyne_laser.so": ray_clouds.create_velodyne,
+    "libgazebo_ros_velodyne_gpu_laser.so": ray_clouds.create_velodyne,
     "libgazebo_ros_camera.so": create_camera,
     "libgazebo_ros_openni_kinect.so": create_depth,
 }
