@@ -48,6 +48,31 @@ with _quiet(1), _quiet(2):
     import pybullet_data
 
 
+#: Probe program: load PyBullet's EGL plugin in a throw-away process. On a machine without an EGL library
+#: the plugin ends the whole process (status 1, no exception), so it must never be tried in ours first.
+_EGL_PROBE = ("import sys, pybullet as p\n"
+              "c = p.connect(p.DIRECT)\n"
+              "sys.exit(0 if p.loadPlugin(sys.argv[1], '_eglRendererPlugin', physicsClientId=c) >= 0 else 3)\n")
+
+
+def egl_probe(plugin_path, timeout=30.0):
+    """None when PyBullet's EGL plugin loads in a child process, else why not (one line)."""
+    import subprocess
+    import sys
+
+    try:
+        proc = subprocess.run([sys.executable, "-c", _EGL_PROBE, plugin_path], stdin=subprocess.DEVNULL,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, timeout=timeout)
+    except (OSError, subprocess.TimeoutExpired) as err:
+        return f"the EGL probe did not finish ({err})"
+    if proc.returncode == 3:
+        return "PyBullet's EGL plugin did not load"
+    if proc.returncode != 0:
+        return (f"PyBullet's EGL plugin ended its process (status {proc.returncode}): no usable EGL/OpenGL "
+                "library on this machine")
+    return None
+
+
 class World:
     """A PyBullet world: ground plane, gravity, fixed time step, stepped only by ``step()``.
 
@@ -286,6 +311,9 @@ class World:
         loader = pkgutil.get_loader("eglRenderer")
         if loader is None:
             return "pybullet has no eglRenderer module"
+        problem = egl_probe(loader.get_filename())
+        if problem is not None:
+            return problem
         with _quiet(1), _quiet(2):
             plugin = pybullet.loadPlugin(loader.get_filename(), "_eglRendererPlugin", physicsClientId=self.client)
         if plugin < 0:

@@ -83,3 +83,13 @@ def test_egl_before_bodies_or_a_reason(tmp_path):
         assert "built already" in late.use_egl()
     finally:
         late.close()
+
+
+def test_egl_probe_reports_a_plugin_that_ends_its_process(monkeypatch):
+    """A machine without EGL: PyBullet's plugin calls exit(); the probe runs it in a child, so we only get
+    a reason (this is what happened in a fresh debootstrap chroot, where it used to end pytest itself)."""
+    from diffbot_sim import physics
+
+    monkeypatch.setattr(physics, "_EGL_PROBE", "import sys; sys.exit(1)\n")
+    reason = physics.egl_probe("/any/plugin.so")
+    assert "ended its process" in reason and "status 1" in reason
