@@ -28,24 +28,33 @@ FACES = ((2.9, "x", -3.0, 3.0), (2.4, "y", -3.1, 3.1), (-1.9, "y", -3.1, 3.1))
 PILLAR = (0.5, 1.2, 0.2)
 
 
+GRAZE = 0.005  # m: a beam this close to an edge (a wall's end, the pillar's silhouette) may go either way
+
+
 def expected_range(ox, oy, angle, rmax):
-    """Distance from (ox, oy) along world ``angle`` to the nearest wall face or the pillar; inf past rmax."""
+    """Distance from (ox, oy) along world ``angle`` to the nearest wall face or the pillar; inf past rmax;
+    NaN for a beam that grazes an edge (within GRAZE), where a millimetre decides between near and far."""
     dx, dy = math.cos(angle), math.sin(angle)
-    best = math.inf
+    best, grazing = math.inf, False
     for face, axis, lo, hi in FACES:
         d, o = (dx, ox) if axis == "x" else (dy, oy)
         if abs(d) < 1e-12:
             continue
         t = (face - o) / d
         other = (oy + t * dy) if axis == "x" else (ox + t * dx)
-        if t > 0 and lo <= other <= hi:
-            best = min(best, t)
+        if t > 0 and lo - GRAZE <= other <= hi + GRAZE:
+            grazing |= not lo + GRAZE <= other <= hi - GRAZE
+            if lo <= other <= hi:
+                best = min(best, t)
     cx, cy = PILLAR[0] - ox, PILLAR[1] - oy
     b = cx * dx + cy * dy
+    miss = abs(cx * dy - cy * dx)  # the beam's distance from the pillar's axis
     disc = b * b - (cx * cx + cy * cy - PILLAR[2] ** 2)
+    if b > 0 and abs(miss - PILLAR[2]) < GRAZE:
+        grazing = True
     if disc >= 0 and b - math.sqrt(disc) > 0:
         best = min(best, b - math.sqrt(disc))
-    return best if best < rmax else math.inf
+    return math.nan if grazing else (best if best < rmax else math.inf)
 
 
 def surface_distance(x, y):
@@ -120,12 +129,14 @@ class LaserTest(unittest.TestCase):
         ranges = np.array(scan.ranges)
         angles = scan.angle_min + np.arange(len(ranges)) * scan.angle_increment
         want = np.array([expected_range(laser[0], laser[1], yaw + a, scan.range_max) for a in angles])
+        clear = ~np.isnan(want)  # beams that graze an edge are left out
+        self.assertGreater(int(clear.sum()), 340, f"{label}: beams left after the grazing ones")
         inf_want, inf_got = np.isinf(want), np.isposinf(ranges)
-        mismatch = int(np.sum(inf_want != inf_got))
-        self.assertLessEqual(mismatch, 2, f"{label}: beams whose +inf disagrees with the geometry: {mismatch}")
+        mismatch = int(np.sum((inf_want != inf_got) & clear))
+        self.assertEqual(mismatch, 0, f"{label}: beams whose +inf disagrees with the geometry")
         self.assertGreater(int(inf_got.sum()), 20, f"{label}: the open side reads +inf")
         self.assertFalse(np.any(np.isneginf(ranges)), label)
-        both = ~inf_want & ~inf_got
+        both = ~inf_want & ~inf_got & clear
         errors = np.abs(ranges[both] - want[both])
         self.assertLess(float(errors.max()), 0.01 + 5 * NOISE, f"{label}: worst beam error")
         self.assertLess(float(errors.mean()), 0.01, f"{label}: mean beam error")
@@ -152,13 +163,20 @@ class LaserTest(unittest.TestCase):
         self.assertIn("/scan", rospy.get_param(SIM + "/sensor/lds"))
         self.assertIn("/sonar", rospy.get_param(SIM + "/sensor/sonar"))
 
-        # 5 Hz in sim time
+        # 5 Hz in sim time. The very first scan may come at the first step (sim time 1/240 s, before the
+        # 0.2 s grid starts), so the periods are measured from the second one.
         t0 = first.header.stamp.to_sec()
-        self.wait(lambda: self.last(self.scans).header.stamp.to_sec() >= t0 + 1.0, 30, "1 s of scans")
+        self.wait(lambda: self.last(self.scans).header.stamp.to_sec() >= t0 + 1.2, 30, "1.2 s of scans")
         with self.lock:
-            stamps = [s.header.stamp.to_sec() for s in self.scans if s.header.stamp.to_sec() >= t0]
+            stamps = [s.header.stamp.to_sec() for s in self.scans if s.header.stamp.to_sec() > t0]
         gaps = np.diff(stamps)
-        self.assertTrue(np.allclose(gaps, 0.2, atol=2e-3), f"scan periods {gaps}")
+        # The schedule is the sim-time grid: every gap a whole number of 0.2 s periods (a scan never comes
+        # early, late or twice); nearly all exactly one. A message lost in transport on a loaded machine
+        # (seen once in a fresh chroot) makes one gap 0.4 s, which says nothing about the sensor's rate.
+        periods = gaps / 0.2
+        self.assertTrue(np.allclose(periods, np.round(periods), atol=0.01) and periods.min() > 0.5,
+                        f"scan periods off the 5 Hz grid: {gaps}")
+        self.assertGreaterEqual(np.mean(np.round(periods) == 1), 0.8, f"too many scans missing: {gaps}")
 
         # at the spawn pose
         scan, sonar, pose = self.settled_scan(t0 + 0.5)
@@ -223,8 +241,11 @@ class LaserTest(unittest.TestCase):
         p, q = pose.position, pose.orientation
         origin = np.array([p.x, p.y, p.z]) + rotate(q, SONAR_IN_FOOTPRINT)
         yaw = yaw_of(q)
-        want = min(expected_range(origin[0], origin[1], yaw + a, 4.0) for a in np.linspace(-0.05, 0.05, 5))
-        want = min(want, 4.0)
+        rays = [expected_range(origin[0], origin[1], yaw + a, 4.0) for a in np.linspace(-0.05, 0.05, 5)]
+        if any(math.isnan(r) for r in rays):
+            rospy.loginfo("figure: sonar %s: %.4f m; a ray grazes an edge, not compared", label, sonar.range)
+            return
+        want = min(min(rays), 4.0)
         self.assertAlmostEqual(sonar.range, want, delta=0.01, msg=f"sonar {label}")
         rospy.loginfo("figure: sonar %s: %.4f m, geometry %.4f m", label, sonar.range, want)
 
