@@ -49,7 +49,12 @@ env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/
     source catkin_ws/devel/setup.bash; for i in $(seq 1 150); do rostopic list 2>/dev/null | grep -qx /odom && break; sleep 0.2; done;
     if rostopic echo -n 1 /odom/header/frame_id; then echo "make run: /odom is up"; r=0; else echo "make run: no /odom"; tail /tmp/run.log; r=1; fi;
     kill -INT -- -$run 2>/dev/null; for i in $(seq 1 50); do kill -0 $run 2>/dev/null || break; sleep 0.2; done;
-    pkill -KILL -x -- "rosmaster|roslaunch|rosout|bullet_sim|robot_state_pub" ; exit $r'
+    exit $r'
 run_status=$?
+# Whatever the chroot left running (a chroot shares the host's process table: pkill by name in it would
+# also hit the host's own ROS processes), identified by its root directory.
+for proc in /proc/[0-9]*; do
+  [ "$(readlink "$proc/root" 2>/dev/null)" = "$(readlink -f "$DIR")" ] && kill -KILL "${proc#/proc/}" 2>/dev/null
+done
 set -e
 [ "$status" -eq 0 ] && [ "$run_status" -eq 0 ]
