@@ -25,6 +25,8 @@ from typing import Dict, List, Tuple
 
 import numpy as np
 
+from .transforms import rpy_matrix
+
 #: Mass [kg] of a root link left without any: PyBullet treats a base of mass 0 as fixed in the world.
 ROOT_PLACEHOLDER_MASS = 1e-6
 #: Mass [kg] of an inertia-less link on a movable joint (Gazebo drops such links; we keep the joint).
@@ -45,15 +47,6 @@ class LumpedUrdf:
     frames: Dict[str, Tuple[str, Tuple[float, float, float], Tuple[float, float, float, float]]]
     lumped: List[str] = field(default_factory=list)  # links merged into another
     placeholders: List[str] = field(default_factory=list)  # links given a placeholder mass
-
-
-def rpy_matrix(rpy):
-    """Rotation matrix of URDF fixed-axis roll, pitch, yaw: Rz(yaw) @ Ry(pitch) @ Rx(roll)."""
-    r, p, y = rpy
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-                     [-sp, cp * sr, cp * cr]])
 
 
 def matrix_rpy(m):

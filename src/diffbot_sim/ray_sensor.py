@@ -22,6 +22,8 @@ from typing import List, Tuple
 
 import numpy as np
 
+from .transforms import rpy_matrix
+
 from .config import _bool, _number
 from .errors import ConfigError
 from .model import tag_value
@@ -198,15 +200,6 @@ def parse_sensor(element, path, name=None):
 
 
 # -- geometry -----------------------------------------------------------------------------------------------
-def rpy_matrix(rpy):
-    """Rotation matrix of fixed-axis roll, pitch, yaw (SDF and URDF): Rz @ Ry @ Rx."""
-    r, p, y = rpy
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-                     [-sp, cp * sr, cp * cr]])
-
-
 def quaternion_matrix(q):
     """Rotation matrix of a unit quaternion (x, y, z, w)."""
     x, y, z, w = q

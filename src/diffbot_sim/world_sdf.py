@@ -33,6 +33,7 @@ import os
 import xml.etree.ElementTree as ET
 
 from .errors import ModelError
+from .transforms import qmul as _qmul
 from .world import IDENTITY, Body, Shape, WorldDescription
 
 #: The SDF versions this reader knows; others are read as the nearest one (with a warning).
@@ -76,15 +77,6 @@ _WORLD_NOT_SIMULATED = ("scene", "gui", "atmosphere", "magnetic_field", "spheric
 
 
 # ------------------------------------------------------------------------------------------ pose math
-
-def _qmul(a, b):
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return (aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-            aw * bw - ax * bx - ay * by - az * bz)
-
 
 def _qnorm(q):
     n = math.sqrt(sum(c * c for c in q))

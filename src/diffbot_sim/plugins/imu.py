@@ -37,6 +37,7 @@ import xml.etree.ElementTree as ET
 import rospy
 from sensor_msgs.msg import Imu
 
+from ..transforms import qconj, qmul
 from .. import noise, ros_msgs
 from ..config import _bool, _number
 from ..errors import ConfigError, ModelError
@@ -51,20 +52,6 @@ _COMMON = ("robotNamespace", "alwaysOn", "always_on", "updateRate", "update_rate
 
 
 # --------------------------------------------------------------------------------------- pure helpers
-
-def qmul(a, b):
-    """Hamilton product of two (x, y, z, w) quaternions."""
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return (aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-            aw * bw - ax * bx - ay * by - az * bz)
-
-
-def qconj(q):
-    return (-q[0], -q[1], -q[2], q[3])
-
 
 def qrotate(q, v):
     """``v`` rotated by unit quaternion ``q`` (frame -> world when q is the frame's orientation)."""

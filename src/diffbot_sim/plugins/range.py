@@ -11,12 +11,12 @@ warning; gazebo_ros says ``/world``); ``radiation`` (``ultrasound``, anything el
 (0.05 rad); ``gaussianNoise`` (0 m); ``updateRate`` (0: each sensor update; else at most one reading per
 ``1/updateRate`` s of the sensor's updates, the sensor's own rate being ``<update_rate>``).
 """
+from sensor_msgs.msg import Range as RangeMsg
+
 from .. import ray_sensor, ros_msgs
 from ..config import _number, _string
 from .base import join, publisher
 from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_namespace
-
-from sensor_msgs.msg import Range as RangeMsg
 
 _READ = ("robotNamespace", "topicName", "frameName", "radiation", "fov", "gaussianNoise", "updateRate")
 
