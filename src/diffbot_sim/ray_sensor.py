@@ -22,11 +22,10 @@ from typing import List, Tuple
 
 import numpy as np
 
-from .transforms import rpy_matrix
-
 from .config import _bool, _number
 from .errors import ConfigError
 from .model import tag_value
+from .transforms import rpy_matrix
 
 
 @dataclass

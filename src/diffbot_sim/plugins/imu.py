@@ -37,9 +37,9 @@ import xml.etree.ElementTree as ET
 import rospy
 from sensor_msgs.msg import Imu
 
-from ..transforms import qconj, qmul
 from .. import noise, ros_msgs
 from ..config import _bool, _number
+from ..transforms import qconj, qmul
 from ..errors import ConfigError, ModelError
 from ..model import tag_value
 from .base import Plugin, join, next_due, publisher
