@@ -169,6 +169,20 @@ def test_raw_terminal_on_a_non_tty_raises_terminal_error():
         os.close(write_end)
 
 
+def read_all(master, size, timeout=5.0):
+    """Read ``size`` bytes from a pty master: the line discipline may pass several writes on in pieces, so
+    one os.read can return only the first (seen once under load)."""
+    import select
+    import time
+
+    data, deadline = b"", time.monotonic() + timeout
+    while len(data) < size and time.monotonic() < deadline:
+        ready, _, _ = select.select([master], [], [], 0.05)
+        if ready:
+            data += os.read(master, 4096)
+    return data
+
+
 def test_status_line_rewrites_in_place(pty_pair):
     master, slave = pty_pair["master"], pty_pair["slave"]
     with open(os.dup(slave), "w", encoding="utf-8") as stream:
@@ -177,9 +191,10 @@ def test_status_line_rewrites_in_place(pty_pair):
         status.show("one")  # unchanged: not written again
         status.show("two")
         status.end()
-    out = os.read(master, 4096)
+    expected = b"\rone\x1b[K\rtwo\x1b[K\r\n"
+    out = read_all(master, len(expected))
     # The final "\n" reaches the master as "\r\n": output processing (ONLCR) stays on.
-    assert out == b"\rone\x1b[K\rtwo\x1b[K\r\n"
+    assert out == expected
 
 
 def test_status_line_is_cut_to_the_terminal_width(pty_pair):
@@ -187,7 +202,8 @@ def test_status_line_is_cut_to_the_terminal_width(pty_pair):
     fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 20, 0, 0))
     with open(os.dup(slave), "w", encoding="utf-8") as stream:
         StatusLine(stream).show("x" * 100)
-    assert os.read(master, 4096) == b"\r" + b"x" * 19 + b"\x1b[K"
+    expected = b"\r" + b"x" * 19 + b"\x1b[K"
+    assert read_all(master, len(expected)) == expected
 
 
 def test_status_line_writes_nothing_when_not_a_terminal():
