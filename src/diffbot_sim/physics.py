@@ -8,7 +8,6 @@ import contextlib
 import math
 import os
 import tempfile
-import xml.etree.ElementTree as ET
 
 from . import lumping
 from .errors import ModelError
@@ -342,6 +341,20 @@ class World:
         self._files = []
 
 
+def _point_velocity(linear, angular, r):
+    """Velocity of a point ``r`` away from where ``linear`` is measured on a rigid body turning at
+    ``angular``: v + w x r (all world axes)."""
+    return (linear[0] + angular[1] * r[2] - angular[2] * r[1],
+            linear[1] + angular[2] * r[0] - angular[0] * r[2],
+            linear[2] + angular[0] * r[1] - angular[1] * r[0])
+
+
+def _into_frame(orientation, *vectors):
+    """World-axes ``vectors`` expressed in the axes of a frame with world ``orientation`` (x, y, z, w)."""
+    _, inverse = pybullet.invertTransform((0, 0, 0), orientation)
+    return tuple(tuple(pybullet.multiplyTransforms((0, 0, 0), inverse, v, (0, 0, 0, 1))[0]) for v in vectors)
+
+
 class Robot:
     """One loaded robot body: joint lookup, motors, state read-out. Created by ``World.load_robot``."""
 
@@ -349,7 +362,6 @@ class Robot:
         self.client = client
         self.frames = dict(frames or {})  # URDF link -> (PyBullet link carrying it, xyz, quaternion)
         self.gravity = -9.81  # set by World.load_robot
-        self._last_velocity = None
         self.body = body
         self.model = model
         self.spawn = (tuple(position), tuple(orientation))
@@ -463,29 +475,9 @@ class Robot:
         com_pos, _ = pybullet.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
         linear, angular = pybullet.getBaseVelocity(self.body, physicsClientId=self.client)
         position, orientation = pose or self.base_pose()
-        # Velocity of the link origin, not of the centre of mass: v + w x (origin - com).
-        r = [position[i] - com_pos[i] for i in range(3)]
-        v = [linear[0] + angular[1] * r[2] - angular[2] * r[1],
-             linear[1] + angular[2] * r[0] - angular[0] * r[2],
-             linear[2] + angular[0] * r[1] - angular[1] * r[0]]
-        _, inverse = pybullet.invertTransform((0, 0, 0), orientation)
-        local_v, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, v, (0, 0, 0, 1))
-        local_w, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, angular, (0, 0, 0, 1))
-        return tuple(local_v), tuple(local_w)
-
-    def base_acceleration(self, pose, dt):
-        """What an accelerometer on the base reads [m/s^2], in the base frame: the change of the base's
-        velocity since the previous call over ``dt``, minus gravity (so +9.81 on z at rest, REP 145)."""
-        linear, _ = pybullet.getBaseVelocity(self.body, physicsClientId=self.client)
-        previous, self._last_velocity = self._last_velocity, linear
-        if previous is None or dt <= 0:
-            accel = [0.0, 0.0, 0.0]
-        else:
-            accel = [(linear[i] - previous[i]) / dt for i in range(3)]
-        accel[2] -= self.gravity
-        _, inverse = pybullet.invertTransform((0, 0, 0), pose[1])
-        local, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, accel, (0, 0, 0, 1))
-        return tuple(local)
+        # Velocity of the link origin, not of the centre of mass.
+        v = _point_velocity(linear, angular, [position[i] - com_pos[i] for i in range(3)])
+        return _into_frame(orientation, v, angular)
 
     def link_motion(self, name):
         """URDF link ``name``'s frame (lumped or not) in the world: (pose ((x, y, z), (qx, qy, qz, qw)),
@@ -507,20 +499,15 @@ class Robot:
                                           physicsClientId=c)
             com, frame, linear, angular = state[0], (state[4], state[5]), state[6], state[7]
         pose = pybullet.multiplyTransforms(frame[0], frame[1], xyz, quat)
-        r = [pose[0][i] - com[i] for i in range(3)]
-        v = (linear[0] + angular[1] * r[2] - angular[2] * r[1],
-             linear[1] + angular[2] * r[0] - angular[0] * r[2],
-             linear[2] + angular[0] * r[1] - angular[1] * r[0])
+        v = _point_velocity(linear, angular, [pose[0][i] - com[i] for i in range(3)])
         return (tuple(pose[0]), tuple(pose[1])), v, tuple(angular)
 
     def link_twist(self, name):
         """(pose, linear velocity [m/s], angular velocity [rad/s]) of URDF link ``name``'s frame, the
         velocities in that frame's own axes (as ``base_twist`` for the root)."""
         pose, linear, angular = self.link_motion(name)
-        _, inverse = pybullet.invertTransform((0, 0, 0), pose[1])
-        local_v, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, linear, (0, 0, 0, 1))
-        local_w, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, angular, (0, 0, 0, 1))
-        return pose, tuple(local_v), tuple(local_w)
+        local_v, local_w = _into_frame(pose[1], linear, angular)
+        return pose, local_v, local_w
 
     def link_imu(self, name, previous_velocity, dt, offset=None):
         """What an IMU on URDF link ``name`` (lumped or not) reads, in the link's frame (or in the frame at
@@ -532,20 +519,15 @@ class Robot:
         pose, linear, angular = self.link_motion(name)
         if offset is not None:
             moved = pybullet.multiplyTransforms(pose[0], pose[1], offset[0], offset[1])
-            r = [moved[0][i] - pose[0][i] for i in range(3)]
-            linear = (linear[0] + angular[1] * r[2] - angular[2] * r[1],
-                      linear[1] + angular[2] * r[0] - angular[0] * r[2],
-                      linear[2] + angular[0] * r[1] - angular[1] * r[0])
+            linear = _point_velocity(linear, angular, [moved[0][i] - pose[0][i] for i in range(3)])
             pose = (tuple(moved[0]), tuple(moved[1]))
         if previous_velocity is None or dt <= 0:
             accel = [0.0, 0.0, 0.0]
         else:
             accel = [(linear[i] - previous_velocity[i]) / dt for i in range(3)]
         accel[2] -= self.gravity
-        _, inverse = pybullet.invertTransform((0, 0, 0), pose[1])
-        local_w, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, angular, (0, 0, 0, 1))
-        local_a, _ = pybullet.multiplyTransforms((0, 0, 0), inverse, accel, (0, 0, 0, 1))
-        return pose, tuple(local_w), tuple(local_a), linear
+        local_w, local_a = _into_frame(pose[1], angular, accel)
+        return pose, local_w, local_a, linear
 
     def set_planar_velocity(self, vx, vy, wz):
         """Holonomic body velocity (gazebo_ros_planar_move): ``vx, vy`` [m/s] in the base frame's heading,

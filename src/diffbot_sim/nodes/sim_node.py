@@ -119,10 +119,6 @@ class RobotRuntime:
 
     def __init__(self, ctx, plugins):
         self.ctx = ctx
-        self.spec = ctx.spec
-        self.model = ctx.model
-        self.robot = ctx.robot
-        self.private = ctx.private
         self.plugins = plugins
 
     def publishers(self):
@@ -447,12 +443,12 @@ def _report(cfg, loaded, world=None):
         for plugin in runtime.plugins:
             params.update(plugin.summary())
         params["plugins"] = ",".join(p.filename for p in runtime.plugins)
-        params["loaded_mass"] = runtime.robot.total_mass()
+        params["loaded_mass"] = runtime.ctx.robot.total_mass()
         params["urdf_mass"] = model.total_mass()
         if item.spec.name:
             params.update({k: v for k, v in cfgmod.as_params(item.spec).items() if k != "name"})
         for key, value in params.items():
-            rospy.set_param(item.runtime.private + key.strip("/"), value)
+            rospy.set_param(runtime.ctx.private + key.strip("/"), value)
         params.update(cfgmod.as_params(cfg))
         summary = ", ".join(f"{k}={v}" for k, v in sorted(params.items()))
         rospy.loginfo(f"bullet_sim: {who}model {model.source} ({model.name}); {summary}")

@@ -143,3 +143,11 @@ class Plugin:
     def summary(self):
         """Effective settings for the start-up report: {name: value}."""
         return {}
+
+    def take_due(self, now, period):
+        """True when the plugin's next publication (``self.next``) is due at sim time ``now``, and moves it
+        one ``period`` on (0: every step; missed slots are skipped, not burst)."""
+        if now + 1e-9 < self.next:
+            return False
+        self.next = next_due(self.next, period, now)
+        return True

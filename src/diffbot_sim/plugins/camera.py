@@ -19,8 +19,8 @@ from sensor_msgs.msg import CameraInfo, Image
 
 from .. import camera_sensor as cam
 from .. import ros_msgs
-from ..errors import ConfigError, ModelError
-from .base import Plugin, join, next_due, publisher
+from ..errors import ModelError
+from .base import Plugin, join, publisher
 
 def choose_renderer(ctx):
     """The renderer cameras use: ``~renderer`` (SimConfig), which the simulator set back to ``tiny`` (with
@@ -111,9 +111,8 @@ class CameraBase(Plugin):
         return rgb, depth
 
     def due(self, now):
-        if now + 1e-9 < self.next:
+        if not self.take_due(now, self.period):
             return False
-        self.next = next_due(self.next, self.period, now)
         return True
 
     def summary(self):

@@ -25,7 +25,7 @@ from sensor_msgs.msg import NavSatFix
 from .. import noise, ros_msgs
 from ..config import _bool, _number
 from ..errors import ModelError
-from .base import Plugin, join, next_due, publisher
+from .base import Plugin, join, publisher
 from .imu import read_tags
 
 FILENAME = "libhector_gazebo_ros_gps.so"
@@ -130,9 +130,8 @@ class Gps(Plugin):
         self.start(now)
 
     def after_step(self, now, stamp, transforms):
-        if now + 1e-9 < self.next:
+        if not self.take_due(now, self.v["period"]):
             return
-        self.next = next_due(self.next, self.v["period"], now)
         dt = 0.0 if self.last_time is None else now - self.last_time
         self.last_time = now
         (position, _), velocity, _ = self.ctx.robot.link_motion(self.v["body"])

@@ -3,7 +3,7 @@ Gazebo's p3d plugin gives them; for judging odometry. Enabled by ``~publish_grou
 from nav_msgs.msg import Odometry
 
 from .. import ros_msgs
-from .base import Plugin, next_due, publisher
+from .base import Plugin, publisher
 
 
 class GroundTruth(Plugin):
@@ -23,9 +23,8 @@ class GroundTruth(Plugin):
         return self.next
 
     def after_step(self, now, stamp, transforms):
-        if now + 1e-9 < self.next:
+        if not self.take_due(now, self.period):
             return
-        self.next = next_due(self.next, self.period, now)
         if self.pub.get_num_connections():
             robot = self.ctx.robot
             pose = robot.base_pose()

@@ -42,7 +42,7 @@ from ..config import _bool, _number
 from ..transforms import qconj, qmul
 from ..errors import ConfigError, ModelError
 from ..model import tag_value
-from .base import Plugin, join, next_due, publisher
+from .base import Plugin, join, publisher
 
 SENSOR_FILENAME = "libgazebo_ros_imu_sensor.so"
 MODEL_FILENAME = "libgazebo_ros_imu.so"
@@ -408,9 +408,8 @@ class ImuPlugin(Plugin):
         self.start(now)
 
     def after_step(self, now, stamp, transforms):
-        if now + 1e-9 < self.next:
+        if not self.take_due(now, self.s.period):
             return
-        self.next = next_due(self.next, self.s.period, now)
         if self.s.lazy and not self.pub.get_num_connections():
             self.velocity = None  # the next reading starts a fresh difference
             return

@@ -7,7 +7,7 @@ from sensor_msgs.msg import JointState
 
 from .. import config as cfgmod
 from .. import ros_msgs
-from .base import Plugin, join, next_due, publisher
+from .base import Plugin, join, publisher
 
 
 class JointStatePublisher(Plugin):
@@ -29,9 +29,8 @@ class JointStatePublisher(Plugin):
         return self.next
 
     def after_step(self, now, stamp, transforms):
-        if now + 1e-9 < self.next:
+        if not self.take_due(now, self.period):
             return
-        self.next = next_due(self.next, self.period, now)
         if self.pub.get_num_connections():  # nobody listening: skip the read-out and the message
             positions, velocities, efforts = self.ctx.robot.joint_states(self.indices)
             self.pub.publish(self.builder.build(stamp, positions, velocities, efforts))

@@ -28,7 +28,7 @@ from ..config import _bool, _number, _string
 from ..errors import ModelError
 from ..kinematics import quaternion_from_yaw, wheel_speeds
 from ..model import tag_value
-from .base import Plugin, finite_twist, join, next_due, publisher
+from .base import Plugin, finite_twist, join, publisher
 from .joint_motors import UNLIMITED_EFFORT
 
 REQUIRED = ("left_wheel_joint_name", "right_wheel_joint_name", "wheel_separation", "wheel_diameter",
@@ -62,6 +62,7 @@ class Kobuki(Plugin):
         self.cmd_time = None
         self.x = self.y = self.yaw = 0.0
         self.last_time = None
+        self._imu_velocity = None  # world velocity of the base frame at the last update (accelerometer)
         self.next = 0.0
         self._lock = threading.Lock()
         self._pending = None
@@ -125,9 +126,8 @@ class Kobuki(Plugin):
         self.ctx.robot.set_velocities(self.idx, [left / self.radius, right / self.radius], [self.torque] * 2)
 
     def after_step(self, now, stamp, transforms):
-        if now + 1e-9 < self.next:
+        if not self.take_due(now, self.period):
             return
-        self.next = next_due(self.next, self.period, now)
         robot = self.ctx.robot
         positions, velocities, efforts = robot.joint_states(self.idx)
         pose = robot.base_pose()
@@ -151,12 +151,15 @@ class Kobuki(Plugin):
             transforms.append(self.tf_builder.build(stamp, (self.x, self.y, 0.0), orientation))
         if self.js_pub.get_num_connections():
             self.js_pub.publish(self.js_builder.build(stamp, positions, velocities, efforts))
+        # The accelerometer differences the base's velocity over each update, subscribed or not, so the
+        # first message after an idle spell is not a difference over the whole spell.
+        _, rates, accel, self._imu_velocity = robot.link_imu(self.ctx.model.root, self._imu_velocity, dt)
         if self.imu_pub.get_num_connections():
-            self.imu_pub.publish(ros_msgs.imu(stamp, self.imu_frame, pose[1], angular,
-                                              robot.base_acceleration(pose, dt)))
+            self.imu_pub.publish(ros_msgs.imu(stamp, self.imu_frame, pose[1], rates, accel))
 
     def start(self, now):
         self.last_time = now
+        self._imu_velocity = None
         self.x = self.y = self.yaw = 0.0
 
     def reset(self, now):

@@ -26,7 +26,7 @@ from .. import ray_sensor, ros_msgs
 from ..config import _number, _string
 from ..errors import ConfigError
 from ..model import tag_value
-from .base import Plugin, join, next_due, publisher
+from .base import Plugin, join, publisher
 
 ROS1_LASERS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so")
 ROS2_RAY = "libgazebo_ros_ray_sensor.so"
@@ -42,6 +42,19 @@ def plugin_tags(element):
 def sensor_seed(ctx, where):
     """The noise seed: the simulator's ``~seed`` (validated in SimConfig), so two runs are identical."""
     return ctx.cfg.seed
+
+
+def ros1_frame(ctx, values, sensor, path, warn=True):
+    """The frame a ROS 1 ray plugin publishes in: ``frameName``, else the sensor's link (gazebo_ros says
+    ``/world``: with a warning when ``warn``), without a leading slash, with the robot's tf_prefix."""
+    if "frameName" in values:
+        frame = _string(f"<frameName> of {path}", values["frameName"])
+    else:
+        frame = sensor.link or "world"
+        if warn:
+            ctx.warnings.append(f"{path}: no <frameName>: using the sensor's link '{frame}' (gazebo_ros would "
+                                "say /world)")
+    return ctx.frame(ctx.clean_frame(frame, path))
 
 
 def ros1_namespace(ctx, values):
@@ -97,9 +110,8 @@ class RaySensorPlugin(Plugin):
         return fractions, world.retro(bodies, links)
 
     def after_step(self, now, stamp, transforms):
-        if now + 1e-9 < self.next:
+        if not self.take_due(now, self.period):
             return
-        self.next = next_due(self.next, self.period, now)
         if self.pub is not None and self.pub.get_num_connections():  # lazy, as gazebo_ros
             self.publish(now, stamp)
 
@@ -174,14 +186,7 @@ def _ros1(ctx, sensor, element, path, filename):
     else:
         topic = "/world"
         ctx.warnings.append(f"{path}: no <topicName>: publishing on /world, {filename}'s default")
-    if "frameName" in values:
-        frame = _string(f"<frameName> of {path}", values["frameName"])
-    else:
-        frame = sensor.link or "world"
-        ctx.warnings.append(f"{path}: no <frameName>: using the sensor's link '{frame}' (gazebo_ros would "
-                            "say /world)")
-    frame = ctx.frame(ctx.clean_frame(frame, path))
-    return Laser(ctx, sensor, element, path, filename, join(ns, topic), frame)
+    return Laser(ctx, sensor, element, path, filename, join(ns, topic), ros1_frame(ctx, values, sensor, path))
 
 
 def ros2_topic(ctx, element, plugin_name, default_ns="/"):

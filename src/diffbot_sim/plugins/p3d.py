@@ -14,7 +14,7 @@ from nav_msgs.msg import Odometry
 from .. import noise, ros_msgs
 from ..config import _number
 from ..errors import ModelError
-from .base import Plugin, join, next_due, publisher
+from .base import Plugin, join, publisher
 from .imu import qconj, qmul, qnormalize, qrotate, quaternion_from_rpy, read_tags, vector
 
 FILENAME = "libgazebo_ros_p3d.so"
@@ -82,9 +82,8 @@ class P3D(Plugin):
         self.next = now
 
     def after_step(self, now, stamp, transforms):
-        if now + 1e-9 < self.next:
+        if not self.take_due(now, self.v["period"]):
             return
-        self.next = next_due(self.next, self.v["period"], now)
         if not self.pub.get_num_connections():
             return
         robot = self.ctx.robot

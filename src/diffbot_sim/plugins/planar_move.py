@@ -15,7 +15,7 @@ from nav_msgs.msg import Odometry
 from .. import ros_msgs
 from ..config import _bool, _number, _string
 from ..model import tag_value
-from .base import Plugin, finite_twist, join, next_due, publisher
+from .base import Plugin, finite_twist, join, publisher
 
 DEFAULTS = {"commandTopic": "cmd_vel", "odometryTopic": "odom", "odometryFrame": "odom",
             "robotBaseFrame": "base_footprint", "odometryRate": 20.0, "publishOdometryTf": True,
@@ -75,9 +75,8 @@ class PlanarMove(Plugin):
         self.ctx.robot.set_planar_velocity(*command)
 
     def after_step(self, now, stamp, transforms):
-        if now + 1e-9 < self.next:
+        if not self.take_due(now, self.period):
             return
-        self.next = next_due(self.next, self.period, now)
         robot = self.ctx.robot
         position, orientation = robot.base_pose()
         if self.pub.get_num_connections():

@@ -16,7 +16,7 @@ from sensor_msgs.msg import Range as RangeMsg
 from .. import ray_sensor, ros_msgs
 from ..config import _number, _string
 from .base import join, publisher
-from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_namespace
+from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
 
 _READ = ("robotNamespace", "topicName", "frameName", "radiation", "fov", "gaussianNoise", "updateRate")
 
@@ -58,13 +58,7 @@ def create(ctx, sensor, element, params):
         ctx.warnings.append(f"{path}: tags ignored (gazebo_ros_range does not read them): {', '.join(ignored)}")
     ns = ros1_namespace(ctx, values)
     topic = _string(f"<topicName> of {path}", values["topicName"]) if "topicName" in values else "/range"
-    if "frameName" in values:
-        frame = _string(f"<frameName> of {path}", values["frameName"])
-    else:
-        frame = sensor.link or "world"
-        ctx.warnings.append(f"{path}: no <frameName>: using the sensor's link '{frame}' (gazebo_ros would "
-                            "say /world)")
-    frame = ctx.frame(ctx.clean_frame(frame, path))
+    frame = ros1_frame(ctx, values, sensor, path)
     ultrasound = values.get("radiation", "ultrasound").strip() == "ultrasound"
     fov = _number(f"<fov> of {path}", values["fov"], low=0.0) if "fov" in values else 0.05
     stddev = _number(f"<gaussianNoise> of {path}", values["gaussianNoise"], low=0.0) \

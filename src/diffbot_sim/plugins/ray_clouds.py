@@ -16,18 +16,13 @@ sensor_msgs/PointCloud2 with x, y, z, intensity, ring, time). Casting and range 
 import numpy as np
 
 from .. import ros_msgs
-from ..config import _bool, _number, _string
+from ..config import _bool, _number
 from .base import join, publisher
-from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_namespace
+from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
 from sensor_msgs.msg import PointCloud, PointCloud2
 
 BLOCK = "libgazebo_ros_block_laser.so"
 VELODYNE = ("libgazebo_ros_velodyne_laser.so", "libgazebo_ros_velodyne_gpu_laser.so")
-
-
-def _frame(ctx, values, sensor, path):
-    frame = values.get("frameName") or sensor.link or "world"
-    return ctx.frame(ctx.clean_frame(_string(f"<frameName> of {path}", frame), path))
 
 
 def _angles(cfg):
@@ -51,7 +46,7 @@ class BlockLaser(RaySensorPlugin):
     def __init__(self, ctx, sensor, element, path, values):
         super().__init__(ctx, sensor, element, path)
         ns = ros1_namespace(ctx, values)
-        self.frame = _frame(ctx, values, sensor, path)
+        self.frame = ros1_frame(ctx, values, sensor, path, warn=False)
         self.noise = _number(f"<gaussianNoise> of {path}", values.get("gaussianNoise", 0.0), low=0.0)
         self.pub = publisher(join(ns, values.get("topicName") or "/world"), PointCloud)
         self.azimuth, self.inclination = _angles(self.cfg)
@@ -77,7 +72,7 @@ class VelodyneLaser(RaySensorPlugin):
         super().__init__(ctx, sensor, element, path)
         ns = ros1_namespace(ctx, values)
         label = lambda tag: f"<{tag}> of {path}"  # noqa: E731
-        self.frame = _frame(ctx, values, sensor, path)
+        self.frame = ros1_frame(ctx, values, sensor, path, warn=False)
         self.min_range = _number(label("min_range"), values.get("min_range", 0.9), low=0.0)
         self.max_range = _number(label("max_range"), values.get("max_range", 130.0), low=0.0, low_open=True)
         self.noise = _number(label("gaussianNoise"), values.get("gaussianNoise", 0.0), low=0.0)

@@ -10,7 +10,7 @@ from .ground_truth import GroundTruth
 from .joint_motors import JointMotors
 from .laser import create_laser, create_ray_sensor
 from .range import create as create_range
-from .tags import DIFF_DRIVE, JOINT_STATE
+from .tags import DIFF_DRIVE, JOINT_STATE, plugin_filename
 
 #: Model plugins by filename (``libNAME.so``).
 MODEL_PLUGINS = {
@@ -37,12 +37,9 @@ SENSOR_PLUGINS = {
     "libgazebo_ros_camera.so": create_camera,
     "libgazebo_ros_openni_kinect.so": create_depth,
 }
-#: Sensors simulated without a plugin of their own, by type (``create(ctx, sensor, None, params)``).
-SENSOR_TYPES = {
-}
 #: Every filename simulated (the rest are named once as not simulated).
 KNOWN = (DIFF_DRIVE, JOINT_STATE) + tuple(MODEL_PLUGINS)
-KNOWN_SENSORS = tuple(SENSOR_PLUGINS) + tuple(f"type:{t}" for t in SENSOR_TYPES)
+KNOWN_SENSORS = tuple(SENSOR_PLUGINS)
 
 
 def build(ctx, found, params):
@@ -60,20 +57,12 @@ def build(ctx, found, params):
         factory = MODEL_PLUGINS.get(item.filename)
         if factory is not None:
             plugins.append(factory(ctx, item.element, item.path, params))
-    for sensor in found.sensors:
+    for sensor in found.sensors:  # a sensor is simulated by its first plugin that a module handles
         for plugin in sensor.element.findall("plugin"):
-            base = (plugin.get("filename") or "").strip().rsplit("/", 1)[-1]
-            base = base if base.endswith(".so") else (f"lib{base}.so" if not base.startswith("lib") else f"{base}.so")
-            factory = SENSOR_PLUGINS.get(base)
+            factory = SENSOR_PLUGINS.get(plugin_filename(plugin.get("filename")))
             if factory is not None:
                 plugins.append(factory(ctx, sensor, plugin, params))
                 break
-        else:
-            factory = SENSOR_TYPES.get(sensor.type)
-            if factory is not None:
-                made = factory(ctx, sensor, None, params)
-                if made is not None:
-                    plugins.append(made)
     js = joint_state.create(ctx, found.joint_state, drive.drive if drive is not None else None)
     if js is not None:
         plugins.append(js)
@@ -84,6 +73,7 @@ def build(ctx, found, params):
     if rest:
         plugins.append(JointMotors(ctx, rest))
     if ctx.cfg.publish_ground_truth:
-        base = next((p.drive.robot_base_frame for p in plugins if hasattr(p, "drive")), ctx.frame(ctx.model.root))
+        base = next((p.drive.robot_base_frame for p in plugins if isinstance(p, diff_drive.DiffDrive)),
+                    ctx.frame(ctx.model.root))
         plugins.append(GroundTruth(ctx, base))
     return plugins

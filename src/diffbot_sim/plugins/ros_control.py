@@ -108,6 +108,7 @@ class RosControl(Plugin):
                                         "the joint keeps a velocity motor")
         self.index = {j: robot.indices([j])[0] for j in self.interfaces if j in robot.joint_index}
         self._check_pid_stability(ns)
+        self.pid_limits = {j: effort_limit(model, j) for j in self.pids}  # read once, used every step
         free = [self.index[j] for j, iface in self.interfaces.items()
                 if j in self.index and (iface == "EffortJointInterface" or j in self.pids)]
         robot.free_joints(free)
@@ -185,7 +186,7 @@ class RosControl(Plugin):
         efforts = []
         for joint, velocity in zip(names, velocities):
             target = 0.0 if self.estop else self.commands.get(joint, 0.0)
-            limit = effort_limit(self.ctx.model, joint)
+            limit = self.pid_limits[joint]
             efforts.append(max(-limit, min(limit, self.pids[joint].update(target - velocity, dt))))
         robot.set_efforts([self.index[j] for j in names], efforts)
 
@@ -337,7 +338,7 @@ class JointStateControllerRunner:
         self.next = now
 
     def update(self, now, stamp, transforms):
-        if now + 1e-9 < self.next:
+        if now + 1e-9 < self.next:  # a controller, not a Plugin: its own schedule
             return
         self.next = next_due(self.next, self.period, now)
         if not self.pub.get_num_connections():

@@ -93,12 +93,19 @@ class Plugins:
     warnings: List[str] = field(default_factory=list)
 
 
+def plugin_filename(text):
+    """A ``<plugin filename=...>`` as Gazebo finds it: the base name, as ``libNAME.so`` ("" for none)."""
+    base = (text or "").strip().rsplit("/", 1)[-1]
+    if base and not base.endswith(".so"):
+        base = f"lib{base}.so" if not base.startswith("lib") else f"{base}.so"
+    return base
+
+
 def read_plugins(model, known=NATIVE, known_sensors=()):
     """Collect the plugin blocks of ``model`` (a RobotModel): the diff drive and joint-state publisher read
     into PluginBlocks, every other plugin as a PluginElement; those whose filename is not in ``known``
     (nor one of the two) are also named in ``unsupported``. Every ``<sensor>`` is collected in ``sensors``;
-    one whose type and plugins match nothing in ``known_sensors`` (filenames, or ``type:NAME`` for a sensor
-    simulated without a plugin) is named in ``unsupported`` too.
+    one with no plugin whose filename is in ``known_sensors`` is named in ``unsupported`` too.
 
     Raises:
         ModelError: a plugin without a filename.
@@ -111,9 +118,7 @@ def read_plugins(model, known=NATIVE, known_sensors=()):
             path = f"{block.path}/plugin[@name='{name}']" if el.get("name") else f"{block.path}/plugin[{index}]"
             if not filename:
                 raise ModelError("plugin has no filename", model.source, path)
-            base = filename.rsplit("/", 1)[-1]
-            if not base.endswith(".so"):
-                base = f"lib{base}.so" if not base.startswith("lib") else f"{base}.so"
+            base = plugin_filename(filename)
             if base == DIFF_DRIVE:
                 if found.diff_drive is not None:
                     found.warnings.append(f"{path}: a second diff-drive plugin is ignored")
@@ -133,13 +138,11 @@ def read_plugins(model, known=NATIVE, known_sensors=()):
             path = f"{block.path}/sensor[@name='{sname}']" if sname else f"{block.path}/sensor[{index}]"
             plugins = []
             for plugin in el.findall("plugin"):
-                base = (plugin.get("filename") or "").strip().rsplit("/", 1)[-1]
-                if base and not base.endswith(".so"):
-                    base = f"lib{base}.so" if not base.startswith("lib") else f"{base}.so"
+                base = plugin_filename(plugin.get("filename"))
                 if base:
                     plugins.append(base)
             found.sensors.append(SensorElement(stype, sname, block.reference, el, path, plugins))
-            if not any(p in known_sensors for p in plugins) and f"type:{stype}" not in known_sensors:
+            if not any(p in known_sensors for p in plugins):
                 found.unsupported.append(f"sensor {sname or '?'} (type {stype or '?'})")
     return found
 
