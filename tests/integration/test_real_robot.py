@@ -9,7 +9,8 @@ wheel_separation_multiplier for it), so in the turn its ground truth need only t
 quarter of the command and stay within 0.2 m, while its own odometry must still read the commanded turn;
 ~odom_is_truth (bool, default false): the drive's odometry is the world pose (gazebo_ros_skid_steer_drive),
 so in the turn it is held to the ground truth's bounds; ~holonomic (bool, default false): also 0.2 m/s
-sideways (linear.y) for 4 s: 0.8 m to the robot's left, heading kept. Callbacks only record; waits poll with deadlines; times are sim time.
+sideways (linear.y) for 4 s: 0.8 m to the robot's left, heading kept; ~imu_topic (optional): the base IMU
+a drive plugin publishes reads +9.81 m/s^2 on z and no yaw rate at rest (REP 145). Callbacks only record; waits poll with deadlines; times are sim time.
 The straight run and the turn are measured and judged by diffbot_sim.drive_check, shared with `robot_check`.
 """
 import math
@@ -22,6 +23,7 @@ import rospy
 import rostest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
+from sensor_msgs.msg import Imu
 
 from diffbot_sim import drive_check
 from diffbot_sim.drive_check import SECONDS, SPEED, TURN, wrap
@@ -65,6 +67,9 @@ class RealRobotTest(unittest.TestCase):
         cls.subs = [rospy.Subscriber(rospy.get_param("~odom_topic"), Odometry, cls.odom, queue_size=1),
                     rospy.Subscriber(SIM + "/ground_truth", Odometry, cls.truth, queue_size=1)]
         cls.pub = rospy.Publisher(cls.cmd_topic, Twist, queue_size=1)
+        cls.imu = Latest()
+        if rospy.has_param("~imu_topic"):
+            cls.subs.append(rospy.Subscriber(rospy.get_param("~imu_topic"), Imu, cls.imu, queue_size=1))
 
     def wait(self, predicate, timeout, what):
         deadline = time.monotonic() + timeout
@@ -101,6 +106,15 @@ class RealRobotTest(unittest.TestCase):
         self.assertAlmostEqual(rospy.get_param(SIM + "/loaded_mass"), urdf_mass, delta=1e-3,
                                msg="loaded mass differs from the URDF's")
         self.stop(1.0)  # settle after the drop onto the ground
+        if rospy.has_param("~imu_topic"):
+            self.wait(lambda: self.imu.count >= 3, 30.0, "the IMU")
+            self.stop(0.5)
+            imu = self.imu.get()
+            a, w = imu.linear_acceleration, imu.angular_velocity
+            rospy.loginfo(f"FIGURE imu at rest: accel ({a.x:.3f}, {a.y:.3f}, {a.z:.3f}), yaw rate {w.z:.4f}")
+            self.assertAlmostEqual(a.z, 9.81, delta=0.1, msg="an IMU at rest reads +g on z (REP 145)")
+            self.assertLess(abs(a.x) + abs(a.y), 0.1)
+            self.assertLess(abs(w.z), 0.01)
 
         (o0, t0), (o1, t1) = self.drive(SPEED, 0.0, SECONDS)
         self.stop()
