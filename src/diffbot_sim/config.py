@@ -44,6 +44,11 @@ class SimConfig:
     renderer: str = "tiny"  # cameras: tiny (PyBullet's TinyRenderer, CPU) or egl (OpenGL via EGL, if it loads)
     debug_cmd_applied: bool = False  # publish ~debug/cmd_applied (wall time a command reached the motors)
     publish_ground_truth: bool = False  # publish ~ground_truth (physics pose, like Gazebo's p3d plugin)
+    paused: bool = False  # start paused (empty_world.launch's paused:=true); unpause_physics starts it
+    autostart_controllers: bool = True  # start every ros_control controller found; false: only a spawner does
+    enable_ros_network: bool = True  # false: no /gazebo services or topics (gazebo_ros's parameter)
+    gazebo_namespace: str = "/gazebo"  # where the gazebo_ros world API lives (spawn_model -gazebo_namespace)
+    physics_engine: str = "ode"  # what the world launch asked for; the engine is always Bullet (noted)
 
 
 @dataclass
@@ -175,7 +180,10 @@ def sim_config(params):
     cfg.renderer = _string(name("renderer"), cfg.renderer).lower()
     if cfg.renderer not in ("tiny", "egl"):
         raise ConfigError(name("renderer"), cfg.renderer, "tiny or egl")
-    for key in ("gui", "real_time", "debug_cmd_applied", "publish_ground_truth"):
+    cfg.gazebo_namespace = "/" + _string(name("gazebo_namespace"), cfg.gazebo_namespace).strip("/")
+    cfg.physics_engine = _string(name("physics_engine"), cfg.physics_engine, allow_empty=True)
+    for key in ("gui", "real_time", "debug_cmd_applied", "publish_ground_truth", "paused",
+                "autostart_controllers", "enable_ros_network"):
         setattr(cfg, key, _bool(name(key), getattr(cfg, key)))
     cfg.time_step = _number(name("time_step"), cfg.time_step, low=1e-5, high=0.05)
     cfg.real_time_factor = _number(name("real_time_factor"), cfg.real_time_factor, low=1e-3)
@@ -285,8 +293,9 @@ def robot_specs(sim, params):
     if "robots" not in params:
         return [RobotSpec(model=sim.model, model_args=sim.model_args, x=sim.x, y=sim.y, z=sim.z, yaw=sim.yaw)]
     entries = params["robots"]
-    if not isinstance(entries, (list, tuple)) or not entries:
-        raise ConfigError("~robots", entries, "a non-empty list of robot names or {name: ..., x: ...} dicts")
+    if not isinstance(entries, (list, tuple)):
+        raise ConfigError("~robots", entries, "a list of robot names or {name: ..., x: ...} dicts (empty: "
+                          "no robot until one is spawned through the /gazebo services)")
     specs = []
     for i, entry in enumerate(entries):
         label = f"~robots[{i}]"

@@ -104,8 +104,9 @@ class World:
         pybullet.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=c)
         self.plane = pybullet.loadURDF("plane.urdf", physicsClientId=c)
 
-    def load_robot(self, urdf_text, model, position=(0.0, 0.0, 0.0), yaw=0.0):
-        """Load a robot; returns a Robot. ``model`` is the parsed RobotModel of the same text.
+    def load_robot(self, urdf_text, model, position=(0.0, 0.0, 0.0), yaw=0.0, orientation=None):
+        """Load a robot; returns a Robot. ``model`` is the parsed RobotModel of the same text. The root link
+        frame is placed at ``position`` turned by ``yaw``, or by the quaternion ``orientation`` when given.
 
         Fixed links are lumped as Gazebo lumps them (:mod:`diffbot_sim.lumping`), not by PyBullet's
         URDF_MERGE_FIXED_LINKS, which would give inertia-less links 1 kg and a merged body one friction.
@@ -116,7 +117,8 @@ class World:
             out.write(prepared.text)
         self._files.append(path)
         flags = pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_USE_IMPLICIT_CYLINDER
-        orientation = pybullet.getQuaternionFromEuler((0.0, 0.0, yaw))
+        if orientation is None:
+            orientation = pybullet.getQuaternionFromEuler((0.0, 0.0, yaw))
         with _quiet(1):
             body = pybullet.loadURDF(path, position, orientation, flags=flags, physicsClientId=self.client)
         if body < 0:
@@ -322,6 +324,52 @@ class World:
             pybullet.removeBody(self.plane, physicsClientId=self.client)
             self.plane = pybullet.loadURDF("plane.urdf", physicsClientId=self.client)
         return None
+
+    # -- the world API (gazebo_ros's /gazebo services): move, remove, push ------------------------------
+    def remove_robot(self, robot):
+        """Delete a robot's body (delete_model)."""
+        pybullet.removeBody(robot.body, physicsClientId=self.client)
+        self.robots.remove(robot)
+        for key in [k for k in self.laser_retro if k[0] == robot.body]:
+            del self.laser_retro[key]
+
+    def remove_body(self, uid):
+        """Delete one world body (delete_model of a world model)."""
+        pybullet.removeBody(uid, physicsClientId=self.client)
+        self.world_bodies = [(u, b) for u, b in self.world_bodies if u != uid]
+        self.laser_retro.pop((uid, -1), None)
+
+    def body_motion(self, uid, inertial_pose):
+        """World body ``uid``'s link frame: (pose, linear velocity of its origin, angular velocity), world
+        axes (as Robot.link_motion)."""
+        com, _ = pybullet.getBasePositionAndOrientation(uid, physicsClientId=self.client)
+        linear, angular = pybullet.getBaseVelocity(uid, physicsClientId=self.client)
+        pose = self.body_pose(uid, inertial_pose)
+        v = _point_velocity(linear, angular, [pose[0][i] - com[i] for i in range(3)])
+        return (tuple(pose[0]), tuple(pose[1])), v, tuple(angular)
+
+    def set_body_motion(self, uid, inertial_pose, pose, linear, angular):
+        """Teleport world body ``uid``'s link frame to ``pose`` with the given velocity of its origin (world
+        axes); a static body only moves."""
+        self._place(uid, pose, inertial_pose)
+        com, _ = pybullet.getBasePositionAndOrientation(uid, physicsClientId=self.client)
+        v = _point_velocity(linear, angular, [com[i] - pose[0][i] for i in range(3)])
+        pybullet.resetBaseVelocity(uid, v, angular, physicsClientId=self.client)
+
+    def apply_wrench(self, uid, link, force, torque, point):
+        """Push body ``uid`` (PyBullet link index ``link``) for the coming step: ``force`` [N] at the world
+        ``point`` and ``torque`` [N·m], world axes (PyBullet clears external forces after each step)."""
+        if any(force):
+            pybullet.applyExternalForce(uid, link, force, point, pybullet.WORLD_FRAME, physicsClientId=self.client)
+        if any(torque):
+            pybullet.applyExternalTorque(uid, link, torque, pybullet.WORLD_FRAME, physicsClientId=self.client)
+
+    def set_gravity(self, gravity):
+        """Gravity [m/s^2] along z for every body from the next step (set_physics_properties)."""
+        self.gravity = gravity
+        pybullet.setGravity(0, 0, gravity, physicsClientId=self.client)
+        for robot in self.robots:
+            robot.gravity = gravity
 
     def reset(self):
         """Put every robot back at its spawn pose and every dynamic world body at its start, at rest."""
@@ -538,6 +586,24 @@ class Robot:
         c, s = math.cos(yaw), math.sin(yaw)
         pybullet.resetBaseVelocity(self.body, (c * vx - s * vy, s * vx + c * vy, linear[2]), (0.0, 0.0, wz),
                                    physicsClientId=self.client)
+
+    def link_carrier(self, name):
+        """PyBullet link index carrying URDF link ``name`` (lumped links: their carrier). KeyError if none."""
+        carrier = self.frames[name][0] if self.frames else name
+        return self._link_index[carrier]
+
+    def set_base_motion(self, pose, linear, angular):
+        """Teleport the root link frame to ``pose`` with the given velocity of its origin [m/s] and angular
+        velocity [rad/s], world axes (set_model_state); joints keep their angles."""
+        com = pybullet.multiplyTransforms(pose[0], pose[1], *pybullet.invertTransform(*self._inertial_inv))
+        pybullet.resetBasePositionAndOrientation(self.body, com[0], com[1], physicsClientId=self.client)
+        v = _point_velocity(linear, angular, [com[0][i] - pose[0][i] for i in range(3)])
+        pybullet.resetBaseVelocity(self.body, v, angular, physicsClientId=self.client)
+
+    def set_joint_positions(self, indices, positions):
+        """Joint angles [rad] set at rest (set_model_configuration)."""
+        for index, position in zip(indices, positions):
+            pybullet.resetJointState(self.body, index, position, 0.0, physicsClientId=self.client)
 
     def reset(self):
         """Back to the spawn pose with every joint at 0 and at rest."""

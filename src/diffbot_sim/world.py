@@ -53,6 +53,12 @@ class Body:
     inertia: Tuple[float, float, float, float, float, float] = (1.0, 1.0, 1.0, 0.0, 0.0, 0.0)
     inertial_pose: Pose = IDENTITY
     color: Optional[Tuple[float, float, float, float]] = None  # rgba of its first <visual>'s material
+    model_pose: Pose = IDENTITY  # world pose of its top-level model's frame at start (the /gazebo model pose)
+
+    @property
+    def top_model(self):
+        """The top-level model it belongs to (``outer`` of ``outer::inner::link``): what /gazebo names."""
+        return self.model.split("::")[0]
 
 
 @dataclass

@@ -911,11 +911,13 @@ class _Reader:
     def emit(self):
         poses = self.poses
 
-        def walk(model, static):
+        def walk(model, static, top):
             static = static or model.static
             for link in model.links.values():
-                pose = poses.get(id(link)) or compose(
-                    self.world_pose(model, link.relative_to, link.src, f"{link.path}/pose"), link.pose)
+                placed = compose(self.world_pose(model, link.relative_to, link.src, f"{link.path}/pose"), link.pose)
+                pose = poses.get(id(link)) or placed
+                # The top-level model's frame, moved with the link by a <state> (the model moves rigidly).
+                in_model = compose(inverse(self.model_pose(top)), placed)
                 if not static and any(s.kind == "plane" for s in link.shapes):
                     self.warn(f"{link.src.path}: {link.path}: a plane in a non-static model is not simulated")
                 mass = link.mass
@@ -925,17 +927,18 @@ class _Reader:
                     mass = 1.0
                 body = Body(name=f"{model.full}::{link.name}", model=model.full, pose=_clean(pose),
                             static=static, shapes=link.shapes, mass=mass, inertia=link.inertia,
-                            inertial_pose=_clean(link.inertial_pose), color=link.color)
+                            inertial_pose=_clean(link.inertial_pose), color=link.color,
+                            model_pose=_clean(compose(pose, inverse(in_model))))
                 for shape in body.shapes:
                     shape.pose = _clean(shape.pose)
                 self.world.bodies.append(body)
                 if static and any(s.kind == "plane" for s in link.shapes):
                     self.world.has_ground = True
             for nested in model.models.values():
-                walk(nested, static)
+                walk(nested, static, top)
 
         for model in self.top:
-            walk(model, False)
+            walk(model, False, model)
 
 
 def read_world(path, model_paths=None, package_model_paths=None):

@@ -12,7 +12,7 @@ import pytest
 from diffbot_sim.config import sim_config
 from diffbot_sim.model import parse_urdf
 from diffbot_sim.physics import World
-from diffbot_sim.plugins import ray_clouds
+from diffbot_sim.plugins import base, ray_clouds
 from diffbot_sim.plugins.base import RobotContext
 from diffbot_sim.plugins.tags import SensorElement
 from diffbot_sim.world import Body, Shape, WorldDescription
@@ -38,7 +38,7 @@ class _Pub:
 
 @pytest.fixture
 def scene(monkeypatch):
-    monkeypatch.setattr(ray_clouds, "publisher", _Pub)
+    monkeypatch.setattr(base, "publisher", _Pub)
     world = World(1.0 / 240.0)
     wall = Body("east", "east", ((3.0, 0.0, 0.5), (0, 0, 0, 1)), True,
                 [Shape("box", (0.2, 6.0, 1.0), surface={"laser_retro": 100.0})])

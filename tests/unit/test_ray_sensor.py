@@ -390,6 +390,9 @@ class _Ctx:
         self.frame = lambda name: name
         self.clean_frame = lambda name, where: RobotContext.clean_frame(self, name, where)
         self.plugin_namespace = lambda tag, default=None: RobotContext.plugin_namespace(self, tag, default)
+        from diffbot_sim.plugins import base
+
+        self.publisher = lambda name, msg_class: base.publisher(name, msg_class)  # stubbed by the tests
 
 
 def _plugin_robot(sensor_xml):
@@ -409,10 +412,9 @@ RAY = ('<ray><scan><horizontal><samples>4</samples><min_angle>-1</min_angle><max
 
 @pytest.fixture
 def stub_publisher(monkeypatch):
-    from diffbot_sim.plugins import laser, range as range_plugin
+    from diffbot_sim.plugins import base
 
-    monkeypatch.setattr(laser, "publisher", _Pub)
-    monkeypatch.setattr(range_plugin, "publisher", _Pub)
+    monkeypatch.setattr(base, "publisher", _Pub)
 
 
 def test_ros1_laser_tags(stub_publisher):
@@ -516,11 +518,11 @@ def test_ros2_outputs_publish_from_the_room(room, monkeypatch, output):
     """The ROS 2 plugin on the fixture's laser link in the hand-built room: each output type is filled."""
     import genpy
 
-    from diffbot_sim.plugins import laser
+    from diffbot_sim.plugins import base, laser
     from diffbot_sim.plugins.tags import read_plugins
 
     world, robot, model = room
-    monkeypatch.setattr(laser, "publisher", _Listened)
+    monkeypatch.setattr(base, "publisher", _Listened)
     lds = next(s for s in read_plugins(model).sensors if s.name == "lds")
     element = ET.fromstring(f'<plugin name="p" filename="libgazebo_ros_ray_sensor.so"><output_type>{output}'
                             '</output_type><min_intensity>1</min_intensity></plugin>')

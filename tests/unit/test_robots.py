@@ -20,8 +20,12 @@ def test_names_and_dicts_mix():
     assert specs[1].tf_prefix == "r2" and specs[0].tf_prefix is None
 
 
+def test_an_empty_robot_list_starts_an_empty_world():
+    """empty_world.launch starts the simulator with ``~robots: []``: robots come from spawn_model."""
+    assert robot_specs(SimConfig(), {"robots": []}) == []
+
+
 @pytest.mark.parametrize("robots, culprit", [
-    ([], "~robots"),
     ("robot1", "~robots"),
     ([{"x": 1}], "~robots[0].name"),
     (["robot1", 3], "~robots[1]"),

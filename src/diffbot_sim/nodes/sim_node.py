@@ -117,9 +117,14 @@ class RobotRuntime:
     The loop asks it what is due and calls it before and after each step; it knows no plugin by name.
     """
 
-    def __init__(self, ctx, plugins):
+    def __init__(self, name, ctx, plugins):
+        self.name = name  # the model name the /gazebo services know it by
         self.ctx = ctx
         self.plugins = plugins
+
+    def close(self):
+        """Remove every topic and service of its plugins (delete_model)."""
+        self.ctx.close()
 
     def publishers(self):
         """This robot's publishers that the loop writes to."""
@@ -176,10 +181,12 @@ class Simulator:
         self.owns_clock = False  # main() sets it when use_sim_time made rospy follow /clock
         self.world_description = None  # the world file's, when ~world names one
         self.links = SubscriberLinks(self.publishers, cfg.send_timeout, 0.0 if cfg.real_time else cfg.fast_batch)
+        self.api = None  # the /gazebo world API (nodes.gazebo_api), when ~enable_ros_network
+        self.paused = cfg.paused
 
     def publishers(self):
         """Every publisher the loop writes to (SubscriberLinks tunes and batches their connections)."""
-        pubs = [self.clock_pub, self.tf_pub]
+        pubs = [self.clock_pub, self.tf_pub] + (self.api.publishers() if self.api is not None else [])
         for runtime in self.robots:
             pubs += runtime.publishers()
         return pubs
@@ -190,36 +197,95 @@ class Simulator:
             held = self.throttle.take_suppressed(key)
             rospy.logwarn(text + (f" ({held} more since the last warning)" if held else ""))
 
-    def add_robot(self, runtime):
-        self.robots.append(runtime)
+    # -- requests from rospy's threads (services, subscribers): the loop does the work -----------------
+    def call(self, action, timeout=5.0):
+        """Run ``action()`` on the loop's thread (the only one that touches physics and plugins) and return
+        its result; an exception it raises is raised here. Works while paused.
 
-    # -- services (called on rospy's threads; the loop does the work) -------------------------------
-    def _request(self, action):
+        Raises:
+            rospy.ServiceException: the loop did not get to it within ``timeout`` wall seconds.
+        """
         done = threading.Event()
+        box = {}
+
+        def run():
+            try:
+                box["result"] = action()
+            except Exception as err:  # handed back to the caller's thread, raised there
+                box["error"] = err
+            done.set()
+        self.post(run)
+        if not done.wait(timeout):
+            raise rospy.ServiceException(f"the simulator loop did not handle the request within {timeout:g} s")
+        if "error" in box:
+            raise box["error"]
+        return box.get("result")
+
+    def post(self, action):
+        """Queue ``action()`` for the loop without waiting (a subscriber callback)."""
         with self._requests_lock:
-            self._requests.append((action, done))
+            self._requests.append(action)
         self.wake.set()
-        if not done.wait(5.0):
-            raise rospy.ServiceException(f"simulator loop did not handle '{action}' within 5 s")
-        return EmptyResponse()
 
     def _handle_requests(self):
         with self._requests_lock:
             requests, self._requests = self._requests, []
-        for action, done in requests:
-            if action == "pause":
-                self.paused = True
-            elif action == "unpause":
-                if self.paused:
-                    self.paused = False
-                    self._rebase()
-            elif action == "reset":
-                self.world.reset()
-                now = self.sim_time
-                for runtime in self.robots:
-                    runtime.reset(now)
-                    runtime.start(now)
-            done.set()
+        for action in requests:
+            action()
+
+    def pause(self):
+        self.paused = True
+
+    def unpause(self):
+        if self.paused:
+            self.paused = False
+            self._rebase()
+
+    def reset_world(self):
+        """gazebo_ros reset_world: every model back to its start pose at rest, plugins reset; sim time goes
+        on."""
+        self.world.reset()
+        now = self.sim_time
+        for runtime in self.robots:
+            runtime.reset(now)
+            runtime.start(now)
+        if self.api is not None:
+            self.api.wrenches.clear_all()
+
+    def reset_simulation(self):
+        """gazebo_ros reset_simulation: as reset_world, and sim time back to 0 (/clock jumps back, as in
+        Gazebo)."""
+        self.steps = 0
+        self.next_clock = 0.0
+        self._next_publish = 0.0
+        self.reset_world()
+        self._publish_clock(0.0)
+        self._rebase()
+
+    def add_robot(self, runtime, now=None):
+        """A robot joins the loop; one spawned while running starts at the current sim time."""
+        self.robots.append(runtime)
+        if now is not None:
+            runtime.start(now)
+            self._next_publish = min(self._next_publish, now)
+
+    def remove_robot(self, runtime):
+        """delete_model: the robot's topics, services and body go."""
+        self.robots.remove(runtime)
+        runtime.close()
+        self.world.remove_robot(runtime.ctx.robot)
+
+    def set_update_rate(self, rate):
+        """set_physics_properties' max_update_rate: steps per wall second (0: as fast as possible)."""
+        if rate > 0:
+            self.cfg.real_time, self.cfg.real_time_factor = True, rate * self.cfg.time_step
+        else:
+            self.cfg.real_time = False
+        self._rebase()
+
+    def stamp(self):
+        """The current sim time as a rospy.Time."""
+        return self._stamp()
 
     @property
     def sim_time(self):
@@ -230,21 +296,27 @@ class Simulator:
         self.wall0 = time.monotonic()
         self.sim0 = self.sim_time
 
+    def _empty(self, action):
+        self.call(action)
+        return EmptyResponse()
+
     def advertise_services(self):
-        rospy.Service("~pause_physics", Empty, lambda _req: self._request("pause"))
-        rospy.Service("~unpause_physics", Empty, lambda _req: self._request("unpause"))
-        rospy.Service("~reset_simulation", Empty, lambda _req: self._request("reset"))
-        # As Gazebo's reset_world: models and robots back to their start; sim time goes on (so does ours on
-        # reset_simulation, which also brakes every plugin).
-        rospy.Service("~reset_world", Empty, lambda _req: self._request("reset"))
+        """The node's own ``~pause_physics``, ``~unpause_physics``, ``~reset_simulation`` and
+        ``~reset_world`` (the /gazebo ones' aliases, kept for launch files written for bullet_sim), unless
+        the node's private namespace is the /gazebo namespace (empty_world.launch names the node gazebo)."""
+        if rospy.get_name().rstrip("/") == self.cfg.gazebo_namespace.rstrip("/"):
+            return
+        for name, action in (("pause_physics", self.pause), ("unpause_physics", self.unpause),
+                             ("reset_simulation", self.reset_simulation), ("reset_world", self.reset_world)):
+            rospy.Service("~" + name, Empty, lambda _req, action=action: self._empty(action))
 
     # -- the loop -----------------------------------------------------------------------------------
     def run(self):
         cfg = self.cfg
         dt = cfg.time_step
         for runtime in self.robots:
-            runtime.start(0.0)
-        self._publish_clock(0.0)
+            runtime.start(self.sim_time)
+        self._publish_clock(self.sim_time)
         self._rebase()
         while not rospy.is_shutdown():
             self._handle_requests()
@@ -278,6 +350,8 @@ class Simulator:
         now = self.sim_time
         for runtime in self.robots:
             runtime.before_step(now)
+        if self.api is not None:
+            self.api.before_step(now)
         self.world.step()
         self.steps += 1
         now = self.sim_time
@@ -295,9 +369,12 @@ class Simulator:
         if transforms and self.tf_pub.get_num_connections():
             self._tf_msg.transforms = transforms
             self.tf_pub.publish(self._tf_msg)
+        if self.api is not None:
+            self.api.after_step(now, stamp)
         if now + 1e-9 >= self.next_clock:
             self._publish_clock(now)
-        self._next_publish = min([self.next_clock] + [r.next_publish() for r in self.robots])
+        self._next_publish = min([self.next_clock] + [r.next_publish() for r in self.robots]
+                                 + ([self.api.next_publish()] if self.api is not None else []))
         self.links.release_if_due(wall)
 
     def _stamp(self):
@@ -316,6 +393,8 @@ class Simulator:
 
     def close(self):
         self.links.release()
+        if self.api is not None:
+            self.api.close()
         self.world.close()
 
 
@@ -344,8 +423,11 @@ class LoadedRobot:
         self.spec, self.model, self.plugins, self.runtime, self.notes = spec, model, plugins, runtime, notes
 
 
-def _build_robot(sim, cfg, spec, params):
-    text, source = _load_model(spec)
+def _build_robot(sim, cfg, spec, params, loaded=None, pose=None, now=None):
+    """Load one robot and give each of its plugins to its module. ``loaded``: the URDF text and its source
+    name (default: the spec's model); ``pose``: its root link's world pose (default: the spec's x, y, z
+    raised onto the world, and yaw); ``now``: the sim time a robot spawned while running starts at."""
+    text, source = loaded or _load_model(spec)
     model = parse_urdf(text, source)
     base_dir = os.path.dirname(source) if os.path.isfile(source) else os.getcwd()
     text, mesh_notes = meshes.prepare_meshes(text, source, base_dir, meshes.default_cache_dir(),
@@ -353,22 +435,84 @@ def _build_robot(sim, cfg, spec, params):
     found = read_plugins(model, known=registry.KNOWN, known_sensors=registry.KNOWN_SENSORS)
     for trans in model.transmissions:
         model.joint(trans.joint, f"/robot/transmission[@name='{trans.name}']")
-    z = max(spec.z, sim.world.top_at(spec.x, spec.y)) if sim.world.world_bodies else spec.z
-    robot = sim.world.load_robot(text, model, (spec.x, spec.y, z), spec.yaw)
-    namespace = "/" + spec.name if spec.name else None
+    if pose is None:
+        z = max(spec.z, sim.world.top_at(spec.x, spec.y)) if sim.world.world_bodies else spec.z
+        robot = sim.world.load_robot(text, model, (spec.x, spec.y, z), spec.yaw)
+        namespace = "/" + spec.name if spec.name else None
+    else:
+        robot = sim.world.load_robot(text, model, pose[0], orientation=pose[1])
+        namespace = None  # a spawn request's robot_namespace is already in its plugins' <robotNamespace>
     ctx = RobotContext(sim, cfg, spec, model, robot, params, namespace, f"~{spec.name}/" if spec.name else "~")
-    runtime = RobotRuntime(ctx, registry.build(ctx, found, params))
-    sim.add_robot(runtime)
+    try:
+        runtime = RobotRuntime(spec.name or model.name, ctx, registry.build(ctx, found, params))
+    except BaseException:
+        ctx.close()
+        sim.world.remove_robot(robot)
+        raise
+    sim.add_robot(runtime, now)
     return LoadedRobot(spec, model, found, runtime, model.warnings + mesh_notes + ctx.warnings)
+
+
+def spawn_robot(sim, cfg, params, name, text, source, pose):
+    """A robot spawned while running (/gazebo/spawn_urdf_model): every plugin, sensor and controller it
+    would get at start; its frames get the ``tf_prefix`` parameter of its namespace when one is set (as
+    gazebo_ros plugins read it), else none. Returns its RobotRuntime; raises DiffbotSimError on bad input."""
+    from ..model import parse_urdf as _parse
+    model_ns = ""
+    for plugin_ns in _plugin_namespaces(_parse(text, source)):
+        model_ns = plugin_ns
+        break
+    prefix = _param(rospy.names.ns_join(model_ns or "/", "tf_prefix"), "") if model_ns else ""
+    spec = cfgmod.RobotSpec(name=name, tf_prefix=str(prefix).strip("/"))
+    item = _build_robot(sim, cfg, spec, params, loaded=(text, source), pose=pose, now=sim.sim_time)
+    _report_robot(cfg, item)
+    return item.runtime
+
+
+def _plugin_namespaces(model):
+    """The ``robotNamespace`` values of a model's plugins (the spawn request's, once injected)."""
+    from ..model import tag_value
+    for block in model.gazebo:
+        for element in block.element.iter("robotNamespace"):
+            value = tag_value(element)
+            if value:
+                yield value
+
+
+def _param(name, default):
+    try:
+        return rospy.get_param(name, default)
+    except (KeyError, rospy.ROSException):
+        return default
+
+
+def resolve_world_path(name, package_root=None):
+    """The world file ``name`` names: a path as given (absolute, or relative to the working directory),
+    else, as gzserver does, relative to each GAZEBO_RESOURCE_PATH directory, then to this package (which
+    ships ``worlds/empty.world``, empty_world.launch's default).
+
+    Raises:
+        ModelError: naming the world and every directory searched.
+    """
+    path = os.path.abspath(os.path.expanduser(name))
+    if os.path.isfile(path) or os.path.isabs(os.path.expanduser(name)):
+        return path
+    package_root = package_root or os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(
+        os.path.realpath(__file__)))))
+    dirs = [d for d in os.environ.get("GAZEBO_RESOURCE_PATH", "").split(":") if d] + [package_root]
+    for directory in dirs:
+        candidate = os.path.join(directory, name)
+        if os.path.isfile(candidate):
+            return candidate
+    raise ModelError(f"no such world file (searched the working directory, GAZEBO_RESOURCE_PATH and "
+                     f"{package_root})", name)
 
 
 def _read_world(cfg):
     """The world file's description (SDF .world, or a map_server .yaml), or None without ``~world``."""
     if not cfg.world:
         return None
-    path = os.path.abspath(os.path.expanduser(cfg.world))
-    if not os.path.isfile(path):
-        raise ModelError("no such world file", path)
+    path = resolve_world_path(cfg.world)
     if path.endswith((".yaml", ".yml")):
         from ..world_map import read_map
         return read_map(path, cfg.map_wall_height)
@@ -418,6 +562,11 @@ def _report(cfg, loaded, world=None):
     """Log the effective configuration once and write it back to the private parameters."""
     for key, value in cfgmod.as_params(cfg).items():
         rospy.set_param("~" + key, value)
+    accepted = [f"{key}={cfg_value}" for key, cfg_value in
+                (("physics", cfg.physics_engine if cfg.physics_engine not in ("", "ode", "bullet") else ""),)
+                if cfg_value]
+    if accepted:
+        rospy.logwarn("bullet_sim: accepted, not simulated (the engine is Bullet): " + ", ".join(accepted))
     if world is not None:
         for text in world.warnings:
             rospy.logwarn(f"world {world.source}: {text}")
@@ -427,31 +576,51 @@ def _report(cfg, loaded, world=None):
         rospy.loginfo(f"bullet_sim: world {world.source} ({world.name}): {len(world.bodies)} bodies, "
                       f"{sum(1 for b in world.bodies if not b.static)} dynamic")
     for item in loaded:
-        found, model, runtime = item.plugins, item.model, item.runtime
-        who = f"robot {item.spec.name}: " if item.spec.name else ""
-        for text in found.warnings + item.notes:
-            rospy.logwarn(who + text)
-        if found.unsupported:
-            rospy.logwarn(who + "not simulated (ignored): " + "; ".join(found.unsupported))
-        for block in (found.diff_drive, found.joint_state):
-            if block is not None and block.unknown_tags:
-                rospy.logwarn(f"{who}{block.path}: unknown tags ignored: {', '.join(block.unknown_tags)}")
-        if not any(p.joints() or p.filename == "libgazebo_ros_planar_move.so" for p in runtime.plugins):
-            rospy.logwarn(who + "the model has no drive plugin or controller that bullet_sim simulates (and no "
-                          "~left_joints): nothing moves it")
-        params = {}
-        for plugin in runtime.plugins:
-            params.update(plugin.summary())
-        params["plugins"] = ",".join(p.filename for p in runtime.plugins)
-        params["loaded_mass"] = runtime.ctx.robot.total_mass()
-        params["urdf_mass"] = model.total_mass()
-        if item.spec.name:
-            params.update({k: v for k, v in cfgmod.as_params(item.spec).items() if k != "name"})
-        for key, value in params.items():
-            rospy.set_param(runtime.ctx.private + key.strip("/"), value)
-        params.update(cfgmod.as_params(cfg))
-        summary = ", ".join(f"{k}={v}" for k, v in sorted(params.items()))
-        rospy.loginfo(f"bullet_sim: {who}model {model.source} ({model.name}); {summary}")
+        _report_robot(cfg, item)
+
+
+def _report_robot(cfg, item):
+    """Log one robot's warnings and effective settings; write them to its private parameters."""
+    found, model, runtime = item.plugins, item.model, item.runtime
+    who = f"robot {item.spec.name}: " if item.spec.name else ""
+    for text in found.warnings + item.notes:
+        rospy.logwarn(who + text)
+    if found.unsupported:
+        rospy.logwarn(who + "not simulated (ignored): " + "; ".join(found.unsupported))
+    for block in (found.diff_drive, found.joint_state):
+        if block is not None and block.unknown_tags:
+            rospy.logwarn(f"{who}{block.path}: unknown tags ignored: {', '.join(block.unknown_tags)}")
+    if not any(p.joints() or p.filename == "libgazebo_ros_planar_move.so" for p in runtime.plugins):
+        rospy.logwarn(who + "the model has no drive plugin or controller that bullet_sim simulates (and no "
+                      "~left_joints): nothing moves it")
+    params = {}
+    for plugin in runtime.plugins:
+        params.update(plugin.summary())
+    params["plugins"] = ",".join(p.filename for p in runtime.plugins)
+    params["loaded_mass"] = runtime.ctx.robot.total_mass()
+    params["urdf_mass"] = model.total_mass()
+    if item.spec.name:
+        params.update({k: v for k, v in cfgmod.as_params(item.spec).items() if k != "name"})
+    for key, value in params.items():
+        rospy.set_param(runtime.ctx.private + key.strip("/"), value)
+    params.update(cfgmod.as_params(cfg))
+    summary = ", ".join(f"{k}={v}" for k, v in sorted(params.items()))
+    rospy.loginfo(f"bullet_sim: {who}model {model.source} ({model.name}); {summary}")
+
+
+def _world_api(sim, cfg, params):
+    """The /gazebo services and topics (None, with a warning, when gazebo_msgs is not built: the overlay
+    left out)."""
+    try:
+        from .gazebo_api import GazeboApi
+    except ImportError as err:
+        rospy.logwarn(f"bullet_sim: no {cfg.gazebo_namespace} services ({err}; the gazebo_msgs overlay "
+                      "package is not built)")
+        return None
+    api = GazeboApi(sim, lambda name, text, source, pose: spawn_robot(sim, cfg, params, name, text, source,
+                                                                      pose))
+    api.advertise()
+    return api
 
 
 def _own_the_clock():
@@ -496,6 +665,10 @@ def _main():
         return 1
     try:
         _report(cfg, loaded, sim.world_description)
+        if not rospy.has_param("/use_sim_time"):
+            rospy.set_param("/use_sim_time", True)  # as gazebo_ros: later nodes follow /clock
+        if cfg.enable_ros_network:
+            sim.api = _world_api(sim, cfg, params)
         sim.advertise_services()
         sim.run()
     finally:

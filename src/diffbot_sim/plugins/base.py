@@ -103,6 +103,43 @@ class RobotContext:
 
     def __post_init__(self):
         self.warnings = []  # start-up warnings of this robot's plugins, logged once in the report
+        self.handles = []  # every publisher, subscriber and service this robot's plugins made
+
+    # -- ROS endpoints: made through the context so that deleting the robot removes every one ---------
+    def publisher(self, name, msg_class):
+        """A synchronous publisher (:func:`publisher`) owned by this robot."""
+        return self._own(publisher(name, msg_class))
+
+    def subscriber(self, name, msg_class, callback, **kwargs):
+        """A rospy.Subscriber owned by this robot (unregistered when the robot is deleted)."""
+        return self._own(rospy.Subscriber(name, msg_class, callback, **kwargs))
+
+    def service(self, name, srv_class, handler):
+        """A rospy.Service owned by this robot (shut down when the robot is deleted)."""
+        return self._own(rospy.Service(name, srv_class, handler))
+
+    def _own(self, handle):
+        self.handles.append(handle)
+        return handle
+
+    def release(self, handle):
+        """Remove one endpoint now (a controller unloaded while the robot lives on)."""
+        if handle in self.handles:
+            self.handles.remove(handle)
+        _close(handle)
+
+    def close(self):
+        """Remove every endpoint of this robot: its topics disappear from the master (delete_model)."""
+        handles, self.handles = self.handles, []
+        for handle in handles:
+            _close(handle)
+
+
+def _close(handle):
+    if isinstance(handle, rospy.Service):
+        handle.shutdown("model deleted")
+    else:
+        handle.unregister()
 
 
 class Plugin:
@@ -134,8 +171,13 @@ class Plugin:
     def after_step(self, now, stamp, transforms):
         """Publish what is due; TF transforms go into ``transforms`` (one TFMessage per step)."""
 
+    #: Sim time of the next publication, for plugins that publish on a schedule (``take_due``).
+    next = 0.0
+
     def start(self, now):
-        """The loop starts at sim time ``now`` (also after a reset)."""
+        """The loop starts at sim time ``now`` (also after a reset, when sim time may have gone back to 0):
+        schedules start again from ``now``."""
+        self.next = now
 
     def reset(self, now):
         """Brake and forget pending commands (reset_simulation)."""

@@ -20,7 +20,7 @@ from sensor_msgs.msg import CameraInfo, Image
 from .. import camera_sensor as cam
 from .. import ros_msgs
 from ..errors import ModelError
-from .base import Plugin, join, publisher
+from .base import Plugin, join
 
 def choose_renderer(ctx):
     """The renderer cameras use: ``~renderer`` (SimConfig), which the simulator set back to ``tiny`` (with
@@ -124,8 +124,8 @@ class Camera(CameraBase):
 
     def __init__(self, ctx, sensor, cfg, tags):
         super().__init__(ctx, sensor, cfg, tags)
-        self.image_pub = publisher(self.topic("image_topic", "image_raw"), Image)
-        self.info_pub = publisher(self.topic("info_topic", "camera_info"), CameraInfo)
+        self.image_pub = ctx.publisher(self.topic("image_topic", "image_raw"), Image)
+        self.info_pub = ctx.publisher(self.topic("info_topic", "camera_info"), CameraInfo)
         channels = 1 if cfg.encoding == "mono8" else 3
         self.image = ros_msgs.ImageBuilder(self.frame, cfg.width, cfg.height, cfg.encoding, channels)
         self.info = ros_msgs.camera_info(self.frame, self.intrinsics)

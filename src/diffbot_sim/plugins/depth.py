@@ -18,7 +18,6 @@ from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 
 from .. import camera_sensor as cam
 from .. import ros_msgs
-from .base import publisher
 from .camera import CameraBase
 
 
@@ -39,11 +38,11 @@ class DepthCamera(CameraBase):
                  ("ir/image_raw", "ir/camera_info", "depth/image_raw", "depth/camera_info", "points"))
         keys = ("image_topic", "info_topic", "depth_topic", "depth_info_topic", "points_topic")
         topics = [self.topic(k, n) for k, n in zip(keys, names)]
-        self.image_pub = publisher(topics[0], Image)
-        self.info_pub = publisher(topics[1], CameraInfo)
-        self.depth_pub = publisher(topics[2], Image)
-        self.depth_info_pub = publisher(topics[3], CameraInfo)
-        self.points_pub = publisher(topics[4], PointCloud2)
+        self.image_pub = ctx.publisher(topics[0], Image)
+        self.info_pub = ctx.publisher(topics[1], CameraInfo)
+        self.depth_pub = ctx.publisher(topics[2], Image)
+        self.depth_info_pub = ctx.publisher(topics[3], CameraInfo)
+        self.points_pub = ctx.publisher(topics[4], PointCloud2)
         self.image = ros_msgs.ImageBuilder(self.frame, cfg.width, cfg.height, "rgb8", 3)
         self.depth = ros_msgs.ImageBuilder(self.frame, cfg.width, cfg.height,
                                            "16UC1" if self.depth16 else "32FC1", 2 if self.depth16 else 4)

@@ -19,7 +19,7 @@ from .. import ros_msgs
 from ..controller import DiffDriveController
 from ..kinematics import quaternion_from_yaw
 from ..odometry import EncoderOdometry
-from .base import Plugin, finite_twist, join, next_due, publisher
+from .base import Plugin, finite_twist, join, next_due
 
 
 class DiffDrive(Plugin):
@@ -47,12 +47,12 @@ class DiffDrive(Plugin):
         self._lock = threading.Lock()
         self._pending = None
         ns = drive.namespace
-        self.cmd_sub = rospy.Subscriber(join(ns, drive.command_topic), Twist, self._on_twist, queue_size=1)
-        self.odom_pub = publisher(join(ns, drive.odometry_topic), Odometry) if drive.publish_odom else None
+        self.cmd_sub = ctx.subscriber(join(ns, drive.command_topic), Twist, self._on_twist, queue_size=1)
+        self.odom_pub = ctx.publisher(join(ns, drive.odometry_topic), Odometry) if drive.publish_odom else None
         self.odom_builder = ros_msgs.OdometryBuilder(drive.odometry_frame, drive.robot_base_frame,
                                                      drive.covariance_x, drive.covariance_y, drive.covariance_yaw)
         self.tf_builder = ros_msgs.TransformBuilder(drive.odometry_frame, drive.robot_base_frame)
-        self.debug_pub = (publisher(ctx.private + "debug/cmd_applied", TwistStamped)
+        self.debug_pub = (ctx.publisher(ctx.private + "debug/cmd_applied", TwistStamped)
                           if cfg.debug_cmd_applied else None)
 
     # -- callbacks (rospy's threads) ----------------------------------------------------------------
@@ -131,6 +131,7 @@ class DiffDrive(Plugin):
             transforms.append(self.tf_builder.build(stamp, position, orientation))
 
     def start(self, now):
+        self.next_update = self.next_odom = now
         positions, _, _ = self.ctx.robot.joint_states([self.left_idx[0], self.right_idx[0]])
         self.encoder.reset(positions[0], positions[1], now)
 

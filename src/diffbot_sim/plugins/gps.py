@@ -25,7 +25,7 @@ from sensor_msgs.msg import NavSatFix
 from .. import noise, ros_msgs
 from ..config import _bool, _number
 from ..errors import ModelError
-from .base import Plugin, join, publisher
+from .base import Plugin, join
 from .imu import read_tags
 
 FILENAME = "libhector_gazebo_ros_gps.so"
@@ -107,8 +107,8 @@ class Gps(Plugin):
             raise ModelError(f"GPS: bodyName '{values['body']}' is not a link of the model", ctx.model.source,
                              path) from None
         ns = ctx.plugin_namespace(values["namespace"])
-        self.fix_pub = publisher(join(ns, values["topic"]), NavSatFix)
-        self.vel_pub = publisher(join(ns, values["velocity_topic"]), Vector3Stamped)
+        self.fix_pub = ctx.publisher(join(ns, values["topic"]), NavSatFix)
+        self.vel_pub = ctx.publisher(join(ns, values["velocity_topic"]), Vector3Stamped)
         frame = ctx.clean_frame(values["frame"], path) or "world"
         self.frame_id = frame if frame in ("world", "map") else ctx.frame(frame)
         self.covariance = covariance(values["position"])

@@ -3,7 +3,7 @@ Gazebo's p3d plugin gives them; for judging odometry. Enabled by ``~publish_grou
 from nav_msgs.msg import Odometry
 
 from .. import ros_msgs
-from .base import Plugin, publisher
+from .base import Plugin
 
 
 class GroundTruth(Plugin):
@@ -11,7 +11,7 @@ class GroundTruth(Plugin):
 
     def __init__(self, ctx, child_frame, rate=100.0):
         self.ctx = ctx
-        self.pub = publisher(ctx.private + "ground_truth", Odometry)
+        self.pub = ctx.publisher(ctx.private + "ground_truth", Odometry)
         self.builder = ros_msgs.OdometryBuilder("world", child_frame, 0.0, 0.0, 0.0)
         self.period = 1.0 / rate
         self.next = 0.0

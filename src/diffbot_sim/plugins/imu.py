@@ -34,7 +34,6 @@ import copy
 import math
 import xml.etree.ElementTree as ET
 
-import rospy
 from sensor_msgs.msg import Imu
 
 from .. import noise, ros_msgs
@@ -42,7 +41,7 @@ from ..config import _bool, _number
 from ..transforms import qconj, qmul
 from ..errors import ConfigError, ModelError
 from ..model import tag_value
-from .base import Plugin, join, publisher
+from .base import Plugin, join
 
 SENSOR_FILENAME = "libgazebo_ros_imu_sensor.so"
 MODEL_FILENAME = "libgazebo_ros_imu.so"
@@ -380,14 +379,14 @@ class ImuPlugin(Plugin):
                              path) from None
         self.reading = Reading(settings, getattr(ctx.robot, "gravity", -9.81))
         ns = ctx.plugin_namespace(settings.namespace)
-        self.pub = publisher(join(ns, settings.topic), Imu)
-        self.bias_pub = publisher(join(ns, settings.bias_topic), Imu) if settings.bias_topic else None
+        self.pub = ctx.publisher(join(ns, settings.topic), Imu)
+        self.bias_pub = ctx.publisher(join(ns, settings.bias_topic), Imu) if settings.bias_topic else None
         self.frame_id = ctx.frame(ctx.clean_frame(settings.frame, path))
         self.service = None
         if settings.service:
             from std_srvs.srv import Empty, EmptyResponse
 
-            self.service = rospy.Service(join(ns, settings.service), Empty, lambda _req: EmptyResponse())
+            self.service = ctx.service(join(ns, settings.service), Empty, lambda _req: EmptyResponse())
         self.next = 0.0
         self.last_time = None
         self.velocity = None

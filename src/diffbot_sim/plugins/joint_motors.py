@@ -10,7 +10,6 @@ and zero until commanded (gazebo_ros_control writes zero effort to an effort joi
 import math
 import threading
 
-import rospy
 from std_msgs.msg import Float64
 
 from .base import Plugin, join
@@ -44,7 +43,7 @@ class JointMotors(Plugin):
             if trans.interface != "PositionJointInterface":
                 robot.free_joints(robot.indices([joint]))
             topic = join(ctx.namespace, f"{joint}_{_SUFFIX[trans.interface]}_controller/command")
-            self.subs.append(rospy.Subscriber(topic, Float64, self._on_command, callback_args=joint, queue_size=1))
+            self.subs.append(ctx.subscriber(topic, Float64, self._on_command, callback_args=joint, queue_size=1))
 
     def joints(self):
         return set(self.transmissions)

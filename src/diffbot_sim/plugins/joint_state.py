@@ -7,7 +7,7 @@ from sensor_msgs.msg import JointState
 
 from .. import config as cfgmod
 from .. import ros_msgs
-from .base import Plugin, join, publisher
+from .base import Plugin, join
 
 
 class JointStatePublisher(Plugin):
@@ -17,7 +17,7 @@ class JointStatePublisher(Plugin):
         self.ctx = ctx
         self.cfg = cfg
         self.indices = ctx.robot.indices(cfg.joints)
-        self.pub = publisher(topic or join(cfg.namespace, cfg.topic), JointState)
+        self.pub = ctx.publisher(topic or join(cfg.namespace, cfg.topic), JointState)
         self.builder = ros_msgs.JointStateBuilder(list(cfg.joints))
         self.period = 1.0 / cfg.update_rate if cfg.update_rate > 0 else 0.0
         self.next = 0.0

@@ -28,7 +28,7 @@ from ..config import _bool, _number, _string
 from ..errors import ModelError
 from ..kinematics import quaternion_from_yaw, wheel_speeds
 from ..model import tag_value
-from .base import Plugin, finite_twist, join, publisher
+from .base import Plugin, finite_twist, join
 from .joint_motors import UNLIMITED_EFFORT
 
 REQUIRED = ("left_wheel_joint_name", "right_wheel_joint_name", "wheel_separation", "wheel_diameter",
@@ -68,13 +68,13 @@ class Kobuki(Plugin):
         self._pending = None
         self._reset_odom = False
         prefix = base_prefix.strip("/")
-        self.cmd_sub = rospy.Subscriber(join(ns, f"{prefix}/commands/velocity"), Twist, self._on_twist,
+        self.cmd_sub = ctx.subscriber(join(ns, f"{prefix}/commands/velocity"), Twist, self._on_twist,
                                         queue_size=1)
-        self.reset_sub = rospy.Subscriber(join(ns, f"{prefix}/commands/reset_odometry"), Empty,
+        self.reset_sub = ctx.subscriber(join(ns, f"{prefix}/commands/reset_odometry"), Empty,
                                           self._on_reset, queue_size=1)
-        self.odom_pub = publisher(join(ns, "odom"), Odometry)
-        self.js_pub = publisher(join(ns, "joint_states"), JointState)
-        self.imu_pub = publisher(join(ns, f"{prefix}/sensors/imu_data"), Imu)
+        self.odom_pub = ctx.publisher(join(ns, "odom"), Odometry)
+        self.js_pub = ctx.publisher(join(ns, "joint_states"), JointState)
+        self.imu_pub = ctx.publisher(join(ns, f"{prefix}/sensors/imu_data"), Imu)
         self.odom_builder = ros_msgs.OdometryBuilder(self.odom_frame, self.base_frame, 0, 0, 0,
                                                      pose_diagonal=POSE_COVARIANCE,
                                                      twist_diagonal=(0.0,) * 6)
@@ -158,7 +158,7 @@ class Kobuki(Plugin):
             self.imu_pub.publish(ros_msgs.imu(stamp, self.imu_frame, pose[1], rates, accel))
 
     def start(self, now):
-        self.last_time = now
+        self.next = self.last_time = now
         self._imu_velocity = None
         self.x = self.y = self.yaw = 0.0
 

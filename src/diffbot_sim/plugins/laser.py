@@ -26,7 +26,7 @@ from .. import ray_sensor, ros_msgs
 from ..config import _number, _string
 from ..errors import ConfigError
 from ..model import tag_value
-from .base import Plugin, join, publisher
+from .base import Plugin, join
 
 ROS1_LASERS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so")
 ROS2_RAY = "libgazebo_ros_ray_sensor.so"
@@ -133,7 +133,7 @@ class Laser(RaySensorPlugin):
         self.filename = filename
         self.topic, self.frame, self.output = topic, frame, output
         self.min_intensity = min_intensity
-        self.pub = publisher(topic, OUTPUT_TYPES[output])
+        self.pub = ctx.publisher(topic, OUTPUT_TYPES[output])
         cfg = self.cfg
         h = cfg.horizontal
         self.middle_row = filename == ROS2_RAY and cfg.vertical.count > 1

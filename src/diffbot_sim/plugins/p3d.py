@@ -14,7 +14,7 @@ from nav_msgs.msg import Odometry
 from .. import noise, ros_msgs
 from ..config import _number
 from ..errors import ModelError
-from .base import Plugin, join, publisher
+from .base import Plugin, join
 from .imu import qconj, qmul, qnormalize, qrotate, quaternion_from_rpy, read_tags, vector
 
 FILENAME = "libgazebo_ros_p3d.so"
@@ -64,7 +64,7 @@ class P3D(Plugin):
                 raise ModelError(f"p3d: '{link}' is not a link of the model", ctx.model.source, path) from None
         self.offset_rot = quaternion_from_rpy(*values["rpy"])
         ns = ctx.plugin_namespace(values["namespace"])
-        self.pub = publisher(join(ns, values["topic"]), Odometry)
+        self.pub = ctx.publisher(join(ns, values["topic"]), Odometry)
         frame = ctx.clean_frame(values["frame"], path) or "world"
         self.frame_id = frame if self.reference is None else ctx.frame(frame)
         self.child = ctx.frame(ctx.clean_frame(values["body"], path))

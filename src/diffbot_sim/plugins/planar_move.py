@@ -8,14 +8,13 @@ Tags (defaults): ``commandTopic`` (cmd_vel), ``odometryTopic`` (odom), ``odometr
 """
 import threading
 
-import rospy
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
 from .. import ros_msgs
 from ..config import _bool, _number, _string
 from ..model import tag_value
-from .base import Plugin, finite_twist, join, publisher
+from .base import Plugin, finite_twist, join
 
 DEFAULTS = {"commandTopic": "cmd_vel", "odometryTopic": "odom", "odometryFrame": "odom",
             "robotBaseFrame": "base_footprint", "odometryRate": 20.0, "publishOdometryTf": True,
@@ -40,8 +39,8 @@ class PlanarMove(Plugin):
         self.next = 0.0
         self._lock = threading.Lock()
         self._pending = None
-        self.sub = rospy.Subscriber(join(ns, values["commandTopic"]), Twist, self._on_twist, queue_size=1)
-        self.pub = publisher(join(ns, values["odometryTopic"]), Odometry)
+        self.sub = ctx.subscriber(join(ns, values["commandTopic"]), Twist, self._on_twist, queue_size=1)
+        self.pub = ctx.publisher(join(ns, values["odometryTopic"]), Odometry)
         self.builder = ros_msgs.OdometryBuilder(self.odom_frame, self.base_frame, 1e-5, 1e-5, 1e-3)
         self.tf_builder = ros_msgs.TransformBuilder(self.odom_frame, self.base_frame)
         self.summary_values = {k: v for k, v in values.items() if v is not None}

@@ -15,7 +15,7 @@ from sensor_msgs.msg import Range as RangeMsg
 
 from .. import ray_sensor, ros_msgs
 from ..config import _number, _string
-from .base import join, publisher
+from .base import join
 from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
 
 _READ = ("robotNamespace", "topicName", "frameName", "radiation", "fov", "gaussianNoise", "updateRate")
@@ -30,7 +30,7 @@ class RangeSensor(RaySensorPlugin):
         self.stddev = stddev
         self.throttle = 1.0 / update_rate if update_rate > 0 else 0.0
         self.last = None
-        self.pub = publisher(topic, RangeMsg)
+        self.pub = ctx.publisher(topic, RangeMsg)
         self.builder = ros_msgs.RangeBuilder(frame, ultrasound, fov, self.cfg.range_min, self.cfg.range_max)
 
     def publish(self, now, stamp):

@@ -17,7 +17,7 @@ import numpy as np
 
 from .. import ros_msgs
 from ..config import _bool, _number
-from .base import join, publisher
+from .base import join
 from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
 from sensor_msgs.msg import PointCloud, PointCloud2
 
@@ -48,7 +48,7 @@ class BlockLaser(RaySensorPlugin):
         ns = ros1_namespace(ctx, values)
         self.frame = ros1_frame(ctx, values, sensor, path, warn=False)
         self.noise = _number(f"<gaussianNoise> of {path}", values.get("gaussianNoise", 0.0), low=0.0)
-        self.pub = publisher(join(ns, values.get("topicName") or "/world"), PointCloud)
+        self.pub = ctx.publisher(join(ns, values.get("topicName") or "/world"), PointCloud)
         self.azimuth, self.inclination = _angles(self.cfg)
 
     def publish(self, now, stamp):
@@ -78,7 +78,7 @@ class VelodyneLaser(RaySensorPlugin):
         self.noise = _number(label("gaussianNoise"), values.get("gaussianNoise", 0.0), low=0.0)
         self.organize = _bool(label("organize_cloud"), values.get("organize_cloud", "false"))
         self.min_intensity = _number(label("min_intensity"), values.get("min_intensity", 0.0))
-        self.pub = publisher(join(ns, values.get("topicName") or "/velodyne_points"), PointCloud2)
+        self.pub = ctx.publisher(join(ns, values.get("topicName") or "/velodyne_points"), PointCloud2)
         self.builder = ros_msgs.RingCloudBuilder(self.frame)
         self.azimuth, self.inclination = _angles(self.cfg)
         rows = self.cfg.vertical.count if self.cfg.vertical.count > 1 else 1

@@ -32,12 +32,12 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Bool, Float64
 
-from .. import controllers, ddc, ros_msgs
+from .. import controllers, ddc, ros_msgs, switching
 from ..config import _number, _string
 from ..errors import ConfigError, ModelError
 from ..kinematics import quaternion_from_yaw
 from ..model import tag_value
-from .base import Plugin, join, next_due, publisher
+from .base import Plugin, join, next_due
 from .joint_motors import effort_limit
 
 #: Controller update period [s] when the plugin gives no ``controlPeriod``. Gazebo runs controllers at
@@ -52,6 +52,7 @@ JSC_TYPE = "joint_state_controller/JointStateController"
 JOINT_COMMAND_TYPES = {"velocity_controllers/JointVelocityController": "VelocityJointInterface",
                        "position_controllers/JointPositionController": "PositionJointInterface",
                        "effort_controllers/JointEffortController": "EffortJointInterface"}
+KNOWN_TYPES = frozenset([ddc.CONTROLLER_TYPE, JSC_TYPE, *JOINT_COMMAND_TYPES])
 
 
 def loop_gain(p, dt, inertia):
@@ -113,11 +114,13 @@ class RosControl(Plugin):
                 if j in self.index and (iface == "EffortJointInterface" or j in self.pids)]
         robot.free_joints(free)
         self.estop = False
-        self.estop_sub = (rospy.Subscriber(join(ns, estop_topic), Bool, self._on_estop, queue_size=1)
+        self.estop_sub = (ctx.subscriber(join(ns, estop_topic), Bool, self._on_estop, queue_size=1)
                           if estop_topic else None)
-        self.controllers = []
+        self.controllers = []  # the running ones, updated every control period in start order
+        self.loaded = {}  # controller name (relative to ns) -> runner: loaded, running or stopped
         self.next_control = 0.0
         self.last_pid_time = None
+        self.now = 0.0  # sim time of the last update: a controller started between steps starts at it
 
     def _check_pid_stability(self, ns):
         """Keep the explicit PID only where its discrete loop is stable at our step.
@@ -191,6 +194,7 @@ class RosControl(Plugin):
         robot.set_efforts([self.index[j] for j in names], efforts)
 
     def after_step(self, now, stamp, transforms):
+        self.now = now
         if now + 1e-9 < self.next_control:
             return
         self.next_control = next_due(self.next_control, self.period, now)
@@ -198,6 +202,7 @@ class RosControl(Plugin):
             controller.update(now, stamp, transforms)
 
     def start(self, now):
+        self.next_control = now
         for pid in self.pids.values():
             pid.reset()
         for joint, iface in self.interfaces.items():
@@ -211,6 +216,50 @@ class RosControl(Plugin):
             self.write(joint, 0.0)
         self.start(now)
 
+    # -- controller_manager (its services call these on the loop's thread) --------------------------
+    def full_name(self, name):
+        return join(self.ns, name)
+
+    def load(self, name):
+        """LoadController: build ``name`` from ``<ns>/<name>`` on the parameter server, stopped."""
+        params = _param(self.full_name(name), None)
+        switching.check_load(name, self.loaded, params, KNOWN_TYPES)
+        runner = make_runner(self.ctx, self, self.full_name(name), params)
+        self.loaded[name] = runner
+        return runner
+
+    def switch(self, start, stop, strictness):
+        """SwitchController: stop, then start (controller_manager's rules, :mod:`diffbot_sim.switching`)."""
+        running = [n for n, r in self.loaded.items() if r in self.controllers]
+        claims = {n: r.joints() for n, r in self.loaded.items()}
+        to_stop, to_start = switching.plan_switch(self.loaded, running, claims, start, stop, strictness)
+        for name in to_stop:
+            runner = self.loaded[name]
+            self.controllers.remove(runner)
+            runner.stop()
+        for name in to_start:
+            runner = self.loaded[name]
+            runner.start(self.now)
+            self.controllers.append(runner)
+
+    def unload(self, name):
+        """UnloadController: a stopped controller goes, with its topics."""
+        running = [n for n, r in self.loaded.items() if r in self.controllers]
+        switching.check_unload(name, self.loaded, running)
+        runner = self.loaded.pop(name)
+        for handle in runner.handles():
+            self.ctx.release(handle)
+
+    def states(self):
+        """[(name, 'running' | 'stopped', type, {interface: [joints]})] for ListControllers."""
+        out = []
+        for name, runner in self.loaded.items():
+            claimed = {}
+            for joint in sorted(runner.joints()):
+                claimed.setdefault(self.interfaces.get(joint, ""), []).append(joint)
+            out.append((name, "running" if runner in self.controllers else "stopped", runner.type, claimed))
+        return out
+
     def summary(self):
         out = {"robot_namespace": self.ns, "control_period": self.period, "robot_sim_type": self.sim_type}
         if self.pids:
@@ -222,6 +271,8 @@ class RosControl(Plugin):
 
 class DiffDriveControllerRunner:
     """One DiffDriveController on the hardware of a RosControl plugin."""
+
+    type = ddc.CONTROLLER_TYPE
 
     def __init__(self, ctx, hw, name, params, manager_ns):
         self.ctx, self.hw, self.name = ctx, hw, name
@@ -250,9 +301,9 @@ class DiffDriveControllerRunner:
         self.base_frame = ctx.frame(cfg.base_frame_id)
         self._lock = threading.Lock()
         self._pending = None
-        self.sub = rospy.Subscriber(join(name, "cmd_vel"), Twist, self._on_twist, queue_size=1)
-        self.odom_pub = publisher(join(name, "odom"), Odometry)
-        self.cmd_out_pub = publisher(join(name, "cmd_vel_out"), TwistStamped) if cfg.publish_cmd else None
+        self.sub = ctx.subscriber(join(name, "cmd_vel"), Twist, self._on_twist, queue_size=1)
+        self.odom_pub = ctx.publisher(join(name, "odom"), Odometry)
+        self.cmd_out_pub = ctx.publisher(join(name, "cmd_vel_out"), TwistStamped) if cfg.publish_cmd else None
         self.odom_builder = ros_msgs.OdometryBuilder(self.odom_frame, self.base_frame, 0, 0, 0,
                                                      pose_diagonal=cfg.pose_covariance_diagonal,
                                                      twist_diagonal=cfg.twist_covariance_diagonal)
@@ -269,8 +320,16 @@ class DiffDriveControllerRunner:
     def publishers(self):
         return [p for p in (self.odom_pub, self.cmd_out_pub) if p is not None]
 
+    def handles(self):
+        return [self.sub] + self.publishers()
+
     def start(self, now):
         self.core.starting(now)
+
+    def stop(self):
+        """diff_drive_controller's stopping(): the wheels are braked."""
+        for joint in self.cfg.joints:
+            self.hw.write(joint, 0.0)
 
     def update(self, now, stamp, transforms):
         if self._pending is not None:
@@ -309,6 +368,8 @@ class DiffDriveControllerRunner:
 class JointStateControllerRunner:
     """joint_state_controller/JointStateController: every transmission joint plus ``extra_joints``."""
 
+    type = JSC_TYPE
+
     def __init__(self, ctx, hw, name, params, manager_ns):
         self.ctx, self.hw, self.name = ctx, hw, name
         rate = params.get("publish_rate")
@@ -324,7 +385,7 @@ class JointStateControllerRunner:
             if isinstance(entry.get("name"), str):
                 self.extra.append((entry["name"], float(entry.get("position", 0.0)),
                                    float(entry.get("velocity", 0.0)), float(entry.get("effort", 0.0))))
-        self.pub = publisher(join(manager_ns, "joint_states"), JointState)
+        self.pub = ctx.publisher(join(manager_ns, "joint_states"), JointState)
         self.builder = ros_msgs.JointStateBuilder(self.joints_ + [e[0] for e in self.extra])
         self.next = 0.0
 
@@ -334,8 +395,14 @@ class JointStateControllerRunner:
     def publishers(self):
         return [self.pub]
 
+    def handles(self):
+        return [self.pub]
+
     def start(self, now):
         self.next = now
+
+    def stop(self):
+        pass
 
     def update(self, now, stamp, transforms):
         if now + 1e-9 < self.next:  # a controller, not a Plugin: its own schedule
@@ -359,13 +426,14 @@ class JointCommandRunner:
 
     def __init__(self, ctx, hw, name, params, manager_ns, interface):
         self.ctx, self.hw, self.name = ctx, hw, name
+        self.type = params.get("type")
         self.joint = _string(f"{name}/joint", params.get("joint"))
         ctx.model.joint(self.joint, name)
         if hw.interfaces.get(self.joint) != interface:
             raise ModelError(f"controller {name} needs joint '{self.joint}' with a {interface} transmission",
                              ctx.model.source)
         self.value = None
-        self.sub = rospy.Subscriber(join(name, "command"), Float64, self._on_command, queue_size=1)
+        self.sub = ctx.subscriber(join(name, "command"), Float64, self._on_command, queue_size=1)
 
     def _on_command(self, msg):
         if math.isfinite(msg.data):
@@ -380,7 +448,13 @@ class JointCommandRunner:
     def publishers(self):
         return []
 
+    def handles(self):
+        return [self.sub]
+
     def start(self, now):
+        pass
+
+    def stop(self):
         pass
 
     def update(self, now, stamp, transforms):
@@ -418,6 +492,26 @@ def create(ctx, element, path, params):
         period = _number(f"<controlPeriod> of {path}", tags["controlPeriod"], low=0.0, low_open=True)
         period = max(period, ctx.cfg.time_step)
     hw = RosControl(ctx, path, ns, period, tags.get("eStopTopic"), sim_type)
+    if ctx.cfg.autostart_controllers:
+        _start_all(ctx, hw, path, ns)
+    ControllerManagerServices(ctx, hw)
+    return hw
+
+
+def make_runner(ctx, hw, name, cparams):
+    """The runner of controller ``name`` (its full parameter namespace) of a simulated type."""
+    kind = cparams.get("type")
+    manager_ns = name.rsplit("/", 1)[0] or "/"
+    if kind == ddc.CONTROLLER_TYPE:
+        return DiffDriveControllerRunner(ctx, hw, name, cparams, manager_ns)
+    if kind == JSC_TYPE:
+        return JointStateControllerRunner(ctx, hw, name, cparams, manager_ns)
+    return JointCommandRunner(ctx, hw, name, cparams, manager_ns, JOINT_COMMAND_TYPES[kind])
+
+
+def _start_all(ctx, hw, path, ns):
+    """``~autostart_controllers``: every controller of a simulated type found under the namespace starts at
+    once, as if a spawner had named them all (our own launch files have no spawner)."""
     controllers = find_controllers(ns)
     if not controllers:
         ctx.warnings.append(f"{path}: no controller found on the parameter server under {ns} (load your "
@@ -425,23 +519,84 @@ def create(ctx, element, path, params):
     owned = {}
     for name, cparams in sorted(controllers.items()):
         kind = cparams.get("type")
-        manager_ns = name.rsplit("/", 1)[0] or "/"
-        try:
-            if kind == ddc.CONTROLLER_TYPE:
-                runner = DiffDriveControllerRunner(ctx, hw, name, cparams, manager_ns)
-            elif kind == JSC_TYPE:
-                runner = JointStateControllerRunner(ctx, hw, name, cparams, manager_ns)
-            elif kind in JOINT_COMMAND_TYPES:
-                runner = JointCommandRunner(ctx, hw, name, cparams, manager_ns, JOINT_COMMAND_TYPES[kind])
-            else:
-                ctx.warnings.append(f"{name}: controller type {kind} is not simulated")
-                continue
-        except ConfigError:
-            raise
+        if kind not in KNOWN_TYPES:
+            ctx.warnings.append(f"{name}: controller type {kind} is not simulated")
+            continue
+        runner = make_runner(ctx, hw, name, cparams)
         for joint in runner.joints():
             if joint in owned:
                 raise ModelError(f"controllers {owned[joint]} and {name} both command joint '{joint}'",
                                  ctx.model.source)
             owned[joint] = name
+        relative = name[len(ns.rstrip("/")) + 1:] if name.startswith(ns.rstrip("/") + "/") else name
+        hw.loaded[relative] = runner
         hw.controllers.append(runner)
-    return hw
+
+
+class ControllerManagerServices:
+    """controller_manager's services in the plugin's namespace (``<robotNamespace>/controller_manager/...``),
+    with controller_manager_msgs' types, so ``rosrun controller_manager spawner`` drives our controllers.
+    Each call runs on the simulator's loop (the only thread that touches controllers and physics)."""
+
+    def __init__(self, ctx, hw):
+        try:
+            from controller_manager_msgs import srv
+        except ImportError:  # the overlay left out: no controller_manager_msgs to serve
+            ctx.warnings.append("controller_manager_msgs is not built (overlay left out): no controller_manager "
+                                "services; controllers start only with ~autostart_controllers")
+            return
+        self.ctx, self.hw, self.srv = ctx, hw, srv
+        base = join(hw.ns, "controller_manager")
+        for name, kind, handler in (("load_controller", srv.LoadController, self._load),
+                                    ("unload_controller", srv.UnloadController, self._unload),
+                                    ("switch_controller", srv.SwitchController, self._switch),
+                                    ("list_controllers", srv.ListControllers, self._list),
+                                    ("list_controller_types", srv.ListControllerTypes, self._types),
+                                    ("reload_controller_libraries", srv.ReloadControllerLibraries,
+                                     self._reload)):
+            ctx.service(join(base, name), kind, handler)
+
+    def _on_loop(self, action, what):
+        """Run ``action`` on the loop; True, or False with the reason logged as controller_manager does."""
+        try:
+            self.ctx.sim.call(action)
+            return True
+        except (switching.SwitchError, ConfigError, ModelError) as err:
+            rospy.logerr(f"controller_manager {self.hw.ns}: {what}: {err}")
+            return False
+
+    def _load(self, req):
+        return self.srv.LoadControllerResponse(self._on_loop(lambda: self.hw.load(req.name), "load"))
+
+    def _unload(self, req):
+        return self.srv.UnloadControllerResponse(self._on_loop(lambda: self.hw.unload(req.name), "unload"))
+
+    def _switch(self, req):
+        ok = self._on_loop(lambda: self.hw.switch(list(req.start_controllers), list(req.stop_controllers),
+                                                  req.strictness), "switch")
+        return self.srv.SwitchControllerResponse(ok)
+
+    def _list(self, _req):
+        from controller_manager_msgs.msg import ControllerState, HardwareInterfaceResources
+
+        states = self.ctx.sim.call(self.hw.states)
+        out = [ControllerState(name=name, state=state, type=kind,
+                               claimed_resources=[HardwareInterfaceResources(f"hardware_interface::{iface}",
+                                                                             joints)
+                                                  for iface, joints in claimed.items() if iface])
+               for name, state, kind, claimed in states]
+        return self.srv.ListControllersResponse(out)
+
+    def _types(self, _req):
+        kinds = sorted(KNOWN_TYPES)
+        return self.srv.ListControllerTypesResponse(kinds, ["controller_interface::ControllerBase"] * len(kinds))
+
+    def _reload(self, req):
+        def action():
+            if self.hw.loaded and not req.force_kill:
+                raise switching.SwitchError("Controller manager: Cannot reload controller libraries because there "
+                                            "are still controllers loaded (force_kill unset)")
+            self.hw.switch([], list(self.hw.loaded), switching.BEST_EFFORT)
+            for name in list(self.hw.loaded):
+                self.hw.unload(name)
+        return self.srv.ReloadControllerLibrariesResponse(self._on_loop(action, "reload libraries"))

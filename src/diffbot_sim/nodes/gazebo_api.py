@@ -1,0 +1,521 @@
+"""gazebo_ros's world API (ROS 1 ``gazebo_ros_api_plugin``) served by the simulator, under ``~gazebo_namespace``
+(``/gazebo``), with gazebo_msgs' own types (built in the workspace from the overlay package).
+
+Services: spawn_urdf_model, spawn_sdf_model, delete_model, get_model_state, set_model_state,
+get_world_properties, get_model_properties, get_link_state, set_link_state, get_physics_properties,
+set_physics_properties, set_model_configuration, apply_body_wrench, clear_body_wrenches, pause_physics,
+unpause_physics, reset_simulation, reset_world. Topics: model_states and link_states (every physics step,
+only while subscribed, as Gazebo), set_model_state and set_link_state (in).
+
+Every request runs on the simulator's loop (``Simulator.call``), the one thread that touches the physics; a
+bad request gets ``success: false`` and a ``status_message`` naming the problem, and the loop goes on.
+Models are the robots (spawned or started with the node) and the top-level models of the world file; a
+link is ``model::link``.
+"""
+import math
+import os
+import tempfile
+
+import rospy
+from gazebo_msgs import msg as gmsg
+from gazebo_msgs import srv as gsrv
+from geometry_msgs.msg import Pose, Twist, Vector3
+from std_msgs.msg import Header
+from std_srvs.srv import Empty, EmptyResponse
+
+from .. import meshes, world_api
+from ..description import package_path
+from ..errors import DiffbotSimError
+from ..plugins.base import publisher
+from ..world_sdf import compose, inverse
+
+#: Time a spawn may take on the loop (mesh conversion of a large model), before the caller gives up.
+SPAWN_TIMEOUT = 60.0
+
+
+def _pose_tuple(msg):
+    p, q = msg.position, msg.orientation
+    return (p.x, p.y, p.z), (q.x, q.y, q.z, q.w)
+
+
+def _twist_tuple(msg):
+    return (msg.linear.x, msg.linear.y, msg.linear.z), (msg.angular.x, msg.angular.y, msg.angular.z)
+
+
+def _pose_msg(pose):
+    msg = Pose()
+    (msg.position.x, msg.position.y, msg.position.z) = pose[0]
+    (msg.orientation.x, msg.orientation.y, msg.orientation.z, msg.orientation.w) = pose[1]
+    return msg
+
+
+def _twist_msg(twist):
+    msg = Twist()
+    (msg.linear.x, msg.linear.y, msg.linear.z) = twist[0]
+    (msg.angular.x, msg.angular.y, msg.angular.z) = twist[1]
+    return msg
+
+
+class RequestError(ValueError):
+    """A request refused with this status message (the simulator goes on)."""
+
+
+class _Robot:
+    """A robot as a Gazebo model: its root link is the model frame."""
+
+    static = False
+
+    def __init__(self, runtime):
+        self.runtime = runtime
+        self.name = runtime.name
+        self.robot = runtime.ctx.robot
+        self.model = runtime.ctx.model
+
+    def links(self):
+        return list(self.model.links)
+
+    def motion(self, link=None):
+        """(pose, linear, angular) of a link frame (the root: the model), world axes."""
+        return self.robot.link_motion(link or self.model.root)
+
+    def set_motion(self, pose, linear, angular, link=None):
+        if link not in (None, self.model.root):
+            raise RequestError(f"link '{self.name}::{link}' is not the model's canonical link "
+                               f"'{self.model.root}': only a whole model can be moved here")
+        self.robot.set_base_motion(pose, linear, angular)
+
+    def body_of(self, link):
+        return self.robot.body, self.robot.link_carrier(link)
+
+
+class _WorldModel:
+    """A top-level model of the world file: its links are separate bodies moved together."""
+
+    def __init__(self, name, bodies, world):
+        self.name, self.bodies, self.world = name, bodies, world  # bodies: [(uid, world.Body)]
+        self.static = all(body.static for _, body in bodies)
+
+    def links(self):
+        return [body.name.split("::")[-1] for _, body in self.bodies]
+
+    def _find(self, link):
+        if link is None:
+            return self.bodies[0]
+        for uid, body in self.bodies:
+            if body.name.split("::")[-1] == link:
+                return uid, body
+        raise KeyError(link)
+
+    def motion(self, link=None):
+        uid, body = self._find(link)
+        pose, linear, angular = self.world.body_motion(uid, body.inertial_pose)
+        if link is None:  # the model frame, carried by its first link
+            pose = compose(pose, inverse(self._in_model(body)))
+        return pose, linear, angular
+
+    @staticmethod
+    def _in_model(body):
+        return compose(inverse(body.model_pose), body.pose)
+
+    def set_motion(self, pose, linear, angular, link=None):
+        if link is not None:
+            uid, body = self._find(link)
+            self.world.set_body_motion(uid, body.inertial_pose, pose, linear, angular)
+            return
+        for uid, body in self.bodies:
+            self.world.set_body_motion(uid, body.inertial_pose, compose(pose, self._in_model(body)),
+                                       linear, angular)
+
+    def body_of(self, link):
+        return self._find(link)[0], -1
+
+
+class GazeboApi:
+    """The /gazebo services and topics. ``spawn_urdf(name, urdf_text, source, pose)`` builds a robot on the
+    loop (every plugin, sensor and controller it would get at start) and returns its RobotRuntime."""
+
+    def __init__(self, sim, spawn_urdf):
+        self.sim = sim
+        self.cfg = sim.cfg
+        self.spawn_urdf = spawn_urdf
+        self.ns = sim.cfg.gazebo_namespace.rstrip("/")
+        self.wrenches = world_api.WrenchSchedule()
+        self.seq = {}
+        self.model_states_pub = publisher(self.ns + "/model_states", gmsg.ModelStates)
+        self.link_states_pub = publisher(self.ns + "/link_states", gmsg.LinkStates)
+        self.handles = []
+
+    # -- the loop's side (called on its thread, like a plugin) --------------------------------------
+    def publishers(self):
+        return [self.model_states_pub, self.link_states_pub]
+
+    def next_publish(self):
+        """Every step while someone listens (Gazebo publishes on every world update), else never."""
+        if self.model_states_pub.get_num_connections() or self.link_states_pub.get_num_connections():
+            return self.sim.sim_time
+        return math.inf
+
+    def before_step(self, now):
+        for body, force, torque, point in self.wrenches.active(now):
+            model, link = world_api.split_link_name(body)
+            entity = self.models().get(model)
+            if entity is None:
+                self.wrenches.clear(body)
+                continue
+            uid, index = entity.body_of(link)
+            self.sim.world.apply_wrench(uid, index, force, torque, point)
+
+    def after_step(self, now, stamp):
+        models = None
+        if self.model_states_pub.get_num_connections():
+            models = self.models()
+            msg = gmsg.ModelStates()
+            for name, entity in models.items():
+                pose, linear, angular = entity.motion()
+                msg.name.append(name)
+                msg.pose.append(_pose_msg(pose))
+                msg.twist.append(_twist_msg((linear, angular)))
+            self.model_states_pub.publish(msg)
+        if self.link_states_pub.get_num_connections():
+            models = models or self.models()
+            msg = gmsg.LinkStates()
+            for name, entity in models.items():
+                for link in entity.links():
+                    pose, linear, angular = entity.motion(link)
+                    msg.name.append(f"{name}::{link}")
+                    msg.pose.append(_pose_msg(pose))
+                    msg.twist.append(_twist_msg((linear, angular)))
+            self.link_states_pub.publish(msg)
+
+    # -- models ------------------------------------------------------------------------------------
+    def models(self):
+        """{name: entity}: world-file models in file order, then robots in spawn order."""
+        out = {}
+        for uid, body in self.sim.world.world_bodies:
+            out.setdefault(body.top_model, []).append((uid, body))
+        models = {name: _WorldModel(name, bodies, self.sim.world) for name, bodies in out.items()}
+        for runtime in self.sim.robots:
+            models[runtime.name] = _Robot(runtime)
+        return models
+
+    def _model(self, name, what="model"):
+        entity = self.models().get(name)
+        if entity is None:
+            raise RequestError(f"{what} '{name}' does not exist")
+        return entity
+
+    def _frame_motion(self, frame, what):
+        """World (pose, linear, angular) of a reference frame: a model or a ``model::link``; None: world."""
+        if world_api.is_world_frame(frame):
+            return None
+        model, link = (frame.rsplit("::", 1) + [None])[:2] if "::" in frame else (frame, None)
+        entity = self.models().get(model)
+        try:
+            if entity is None:
+                raise KeyError(frame)
+            return entity.motion(link)
+        except KeyError:
+            raise RequestError(f"{what} '{frame}' not found: not a model nor a model::link") from None
+
+    def _relative(self, motion, frame_motion):
+        pose, linear, angular = motion
+        if frame_motion is None:
+            return pose, (linear, angular)
+        fpose, flin, fang = frame_motion
+        return world_api.relative_state(pose, (linear, angular), fpose, (flin, fang))
+
+    def _absolute(self, pose, twist, frame_motion):
+        if frame_motion is None:
+            return pose, twist
+        fpose, flin, fang = frame_motion
+        return world_api.world_state(pose, twist, fpose, (flin, fang))
+
+    # -- ROS side ------------------------------------------------------------------------------------
+    def advertise(self):
+        ns = self.ns
+        service = lambda name, kind, handler: self.handles.append(  # noqa: E731
+            rospy.Service(f"{ns}/{name}", kind, handler))
+        service("spawn_urdf_model", gsrv.SpawnModel, lambda req: self._spawn(req, "urdf"))
+        service("spawn_sdf_model", gsrv.SpawnModel, lambda req: self._spawn(req, "sdf"))
+        service("delete_model", gsrv.DeleteModel, self._delete)
+        service("get_model_state", gsrv.GetModelState, self._get_model_state)
+        service("set_model_state", gsrv.SetModelState, self._set_model_state)
+        service("get_world_properties", gsrv.GetWorldProperties, self._world_properties)
+        service("get_model_properties", gsrv.GetModelProperties, self._model_properties)
+        service("get_link_state", gsrv.GetLinkState, self._get_link_state)
+        service("set_link_state", gsrv.SetLinkState, self._set_link_state)
+        service("get_physics_properties", gsrv.GetPhysicsProperties, self._get_physics)
+        service("set_physics_properties", gsrv.SetPhysicsProperties, self._set_physics)
+        service("set_model_configuration", gsrv.SetModelConfiguration, self._set_configuration)
+        service("apply_body_wrench", gsrv.ApplyBodyWrench, self._apply_wrench)
+        service("clear_body_wrenches", gsrv.BodyRequest, self._clear_wrenches)
+        for name, action in (("pause_physics", self.sim.pause), ("unpause_physics", self.sim.unpause),
+                             ("reset_simulation", self.sim.reset_simulation), ("reset_world", self.sim.reset_world)):
+            service(name, Empty, lambda _req, action=action: self._empty(action))
+        self.handles.append(rospy.Subscriber(f"{ns}/set_model_state", gmsg.ModelState, self._on_model_state,
+                                             queue_size=10))
+        self.handles.append(rospy.Subscriber(f"{ns}/set_link_state", gmsg.LinkState, self._on_link_state,
+                                             queue_size=10))
+
+    def _run(self, action, response, timeout=5.0):
+        """Run ``action`` on the loop; fill ``response.success``/``status_message``; never raise for a bad
+        request (the caller gets success false and the reason)."""
+        try:
+            result = self.sim.call(action, timeout)
+            response.success = True
+            response.status_message = result if isinstance(result, str) else "ok"
+        except (RequestError, ValueError, DiffbotSimError) as err:
+            response.success = False
+            response.status_message = f"{type(self).__name__.replace('Api', '')}: {err}"
+            rospy.logwarn(f"{self.ns}: {response.status_message}")
+        return response
+
+    def _empty(self, action):
+        self.sim.call(action)
+        return EmptyResponse()
+
+    # spawn / delete
+    def _spawn(self, req, service_kind):
+        response = gsrv.SpawnModelResponse()
+        return self._run(lambda: self._spawn_on_loop(req, service_kind), response, SPAWN_TIMEOUT)
+
+    def _spawn_on_loop(self, req, service_kind):
+        name = req.model_name
+        if not name or "::" in name or "/" in name:
+            raise RequestError(f"SpawnModel: model_name '{name}' is not a valid model name")
+        if name in self.models():
+            raise RequestError(f"SpawnModel: Failure - entity '{name}' already exists.")
+        kind = world_api.model_xml_kind(req.model_xml)
+        pose = world_api.check_pose(_pose_tuple(req.initial_pose), "initial_pose")
+        frame = self._frame_motion(req.reference_frame, "reference_frame")
+        if frame is not None:
+            pose = compose(frame[0], pose)
+        namespace = req.robot_namespace
+        if kind == "urdf":
+            text = world_api.prepare_urdf(req.model_xml, package_path)
+            text = world_api.inject_robot_namespace(text, namespace)
+            text = world_api.rename_model(text, "urdf", name)
+            runtime = self.spawn_urdf(name, text, f"{self.ns}/spawn_{service_kind}_model({name})", pose)
+            return f"SpawnModel: Successfully spawned entity '{runtime.name}'"
+        text = world_api.inject_robot_namespace(req.model_xml, namespace)
+        text = world_api.rename_model(text, "sdf", name)
+        count = self._spawn_sdf(name, text, pose)
+        return f"SpawnModel: Successfully spawned entity '{name}' ({count} bodies)"
+
+    def _spawn_sdf(self, name, text, pose):
+        """An SDF model becomes world bodies: the model's pose replaced by the request's, as Gazebo does."""
+        from ..world_sdf import read_world, ros_package_model_paths
+        model_xml = world_api.sdf_model_at(text, pose)
+        with tempfile.TemporaryDirectory(prefix="spawn_sdf_") as tmp:
+            path = os.path.join(tmp, f"{name}.world")
+            with open(path, "w") as out:
+                out.write(f'<sdf version="1.7"><world name="spawn">{model_xml}</world></sdf>')
+            world = read_world(path, package_model_paths=ros_package_model_paths())
+        for text in world.warnings + [f"not simulated: {'; '.join(world.not_simulated)}"] * bool(world.not_simulated):
+            rospy.logwarn(f"spawned model {name}: {text}")
+        world.has_ground = False  # a spawned plane does not replace the ground
+        return self.sim.world.load_world(world, meshes.default_cache_dir())
+
+    def _delete(self, req):
+        response = gsrv.DeleteModelResponse()
+
+        def action():
+            entity = self._model(req.model_name)
+            if isinstance(entity, _Robot):
+                self.sim.remove_robot(entity.runtime)
+            else:
+                for uid, _ in entity.bodies:
+                    self.sim.world.remove_body(uid)
+            self.wrenches.clear_model(req.model_name)
+            return f"DeleteModel: successfully deleted model '{req.model_name}'"
+        return self._run(action, response)
+
+    # model and link state
+    def _get_model_state(self, req):
+        response = gsrv.GetModelStateResponse()
+
+        def action():
+            entity = self._model(req.model_name, "GetModelState: model")
+            frame = self._frame_motion(req.relative_entity_name, "GetModelState: relative_entity_name")
+            pose, twist = self._relative(entity.motion(), frame)
+            self.seq[req.model_name] = self.seq.get(req.model_name, 0) + 1
+            response.header = Header(seq=self.seq[req.model_name], stamp=self.sim.stamp(),
+                                     frame_id=req.relative_entity_name)
+            response.pose, response.twist = _pose_msg(pose), _twist_msg(twist)
+            return "GetModelState: got properties"
+        return self._run(action, response)
+
+    def _set_state(self, name, link, pose_msg, twist_msg, frame_name):
+        """SetModelState / SetLinkState on the loop: pose and twist relative to ``frame_name``."""
+        entity = self._model(name, "SetModelState: model")
+        if link is not None and link not in entity.links():
+            raise RequestError(f"link '{name}::{link}' does not exist")
+        pose = world_api.check_pose(_pose_tuple(pose_msg), "pose")
+        twist = world_api.check_twist(_twist_tuple(twist_msg), "twist")
+        frame = self._frame_motion(frame_name, "reference_frame")
+        pose, (linear, angular) = self._absolute(pose, twist, frame)
+        entity.set_motion(pose, linear, angular, link)
+
+    def _set_model_state(self, req):
+        state = req.model_state
+        return self._run(lambda: self._set_state(state.model_name, None, state.pose, state.twist,
+                                                 state.reference_frame) or "SetModelState: set model state done",
+                         gsrv.SetModelStateResponse())
+
+    def _on_model_state(self, state):
+        self.sim.post(lambda: self._set_state_logged(state.model_name, None, state.pose, state.twist,
+                                                     state.reference_frame))
+
+    def _on_link_state(self, state):
+        model, link = self._split(state.link_name)
+        self.sim.post(lambda: self._set_state_logged(model, link, state.pose, state.twist, state.reference_frame))
+
+    def _set_state_logged(self, *args):
+        try:
+            self._set_state(*args)
+        except (RequestError, ValueError) as err:
+            self.sim.warn(f"set_state:{args[0]}", f"{self.ns}/set_model_state (topic): {err}")
+
+    @staticmethod
+    def _split(name):
+        try:
+            return world_api.split_link_name(name)
+        except ValueError:
+            return name, ""
+
+    def _get_link_state(self, req):
+        response = gsrv.GetLinkStateResponse()
+
+        def action():
+            model, link = world_api.split_link_name(req.link_name)
+            entity = self._model(model, "GetLinkState: model")
+            if link not in entity.links():
+                raise RequestError(f"GetLinkState: link '{req.link_name}' does not exist")
+            frame = self._frame_motion(req.reference_frame, "GetLinkState: reference_frame")
+            pose, twist = self._relative(entity.motion(link), frame)
+            response.link_state = gmsg.LinkState(link_name=req.link_name, pose=_pose_msg(pose),
+                                                 twist=_twist_msg(twist), reference_frame=req.reference_frame)
+            return "GetLinkState: got state"
+        return self._run(action, response)
+
+    def _set_link_state(self, req):
+        state = req.link_state
+
+        def action():
+            model, link = world_api.split_link_name(state.link_name)
+            self._set_state(model, link, state.pose, state.twist, state.reference_frame)
+            return "SetLinkState: success"
+        return self._run(action, gsrv.SetLinkStateResponse())
+
+    # properties
+    def _world_properties(self, _req):
+        response = gsrv.GetWorldPropertiesResponse()
+
+        def action():
+            response.sim_time = self.sim.sim_time
+            response.model_names = list(self.models())
+            response.rendering_enabled = True
+            return "GetWorldProperties: got properties"
+        return self._run(action, response)
+
+    def _model_properties(self, req):
+        response = gsrv.GetModelPropertiesResponse()
+
+        def action():
+            entity = self._model(req.model_name, "GetModelProperties: model")
+            response.parent_model_name = ""
+            response.body_names = entity.links()
+            response.canonical_body_name = response.body_names[0] if response.body_names else ""
+            if isinstance(entity, _Robot):
+                model = entity.model
+                response.canonical_body_name = model.root
+                response.joint_names = [j.name for j in model.joints.values() if j.type != "fixed"]
+                response.geom_names = [f"{link}_collision" for link in entity.links()
+                                       if getattr(model.links[link], "collisions", None)]
+            response.is_static = entity.static
+            return "GetModelProperties: got properties"
+        return self._run(action, response)
+
+    def _get_physics(self, _req):
+        response = gsrv.GetPhysicsPropertiesResponse()
+
+        def action():
+            cfg = self.cfg
+            values = world_api.physics_properties(cfg.time_step, cfg.real_time_factor, cfg.real_time,
+                                                  self.sim.paused, self.sim.world.gravity)
+            response.time_step = values["time_step"]
+            response.pause = values["pause"]
+            response.max_update_rate = values["max_update_rate"]
+            response.gravity = Vector3(*values["gravity"])
+            for key, value in values["ode_config"].items():
+                setattr(response.ode_config, key, value)
+            return "GetPhysicsProperties: got properties"
+        return self._run(action, response)
+
+    def _set_physics(self, req):
+        def action():
+            cfg = self.cfg
+            if req.time_step and abs(req.time_step - cfg.time_step) > 1e-12:
+                raise RequestError(f"SetPhysicsProperties: time_step {req.time_step:g} s: the step is fixed at "
+                                   f"start (~time_step, {cfg.time_step:g} s)")
+            g = req.gravity
+            if not all(math.isfinite(v) for v in (g.x, g.y, g.z, req.max_update_rate)):
+                raise RequestError("SetPhysicsProperties: gravity and max_update_rate must be finite")
+            if abs(g.x) > 1e-12 or abs(g.y) > 1e-12:
+                rospy.logwarn(f"{self.ns}/set_physics_properties: horizontal gravity is not simulated")
+            self.sim.world.set_gravity(g.z)
+            self.sim.set_update_rate(req.max_update_rate)
+            return "SetPhysicsProperties: physics properties set"
+        return self._run(action, gsrv.SetPhysicsPropertiesResponse())
+
+    def _set_configuration(self, req):
+        def action():
+            entity = self._model(req.model_name, "SetModelConfiguration: model")
+            if not isinstance(entity, _Robot):
+                raise RequestError(f"SetModelConfiguration: model '{req.model_name}' has no joints")
+            if len(req.joint_names) != len(req.joint_positions):
+                raise RequestError("SetModelConfiguration: joint_names and joint_positions differ in length")
+            robot = entity.robot
+            for joint, position in zip(req.joint_names, req.joint_positions):
+                if joint not in robot.joint_index:
+                    raise RequestError(f"SetModelConfiguration: joint '{joint}' is not a moving joint of "
+                                       f"'{req.model_name}'")
+                if not math.isfinite(position):
+                    raise RequestError(f"SetModelConfiguration: joint '{joint}' position is {position}")
+            robot.set_joint_positions(robot.indices(list(req.joint_names)), list(req.joint_positions))
+            return "SetModelConfiguration: success"
+        return self._run(action, gsrv.SetModelConfigurationResponse())
+
+    # wrenches
+    def _apply_wrench(self, req):
+        def action():
+            model, link = world_api.split_link_name(req.body_name)
+            entity = self._model(model, "ApplyBodyWrench: body")
+            if link not in entity.links():
+                raise RequestError(f"ApplyBodyWrench: body '{req.body_name}' does not exist")
+            frame = self._frame_motion(req.reference_frame, "ApplyBodyWrench: reference_frame")
+            w = req.wrench
+            force = (w.force.x, w.force.y, w.force.z)
+            torque = (w.torque.x, w.torque.y, w.torque.z)
+            point = (req.reference_point.x, req.reference_point.y, req.reference_point.z)
+            if not all(math.isfinite(v) for v in force + torque + point):
+                raise RequestError("ApplyBodyWrench: wrench and reference_point must be finite")
+            body_pose = entity.motion(link)[0]
+            frame_pose = body_pose if frame is None and not world_api.is_world_frame(req.reference_frame) \
+                else (frame[0] if frame is not None else None)
+            force, torque, point = world_api.wrench_to_world(force, torque, point, frame_pose, body_pose)
+            self.wrenches.add(req.body_name, force, torque, point, req.start_time.to_sec(),
+                              req.duration.to_sec(), self.sim.sim_time)
+            return ""
+        return self._run(action, gsrv.ApplyBodyWrenchResponse())
+
+    def _clear_wrenches(self, req):
+        self.sim.call(lambda: self.wrenches.clear(req.body_name))
+        return gsrv.BodyRequestResponse()
+
+    def close(self):
+        for handle in self.handles:
+            if isinstance(handle, rospy.Service):
+                handle.shutdown("closing")
+            else:
+                handle.unregister()
