@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""~pause_physics freezes sim time, ~unpause_physics resumes it, ~reset_simulation restores the pose."""
+"""~pause_physics freezes sim time, ~unpause_physics resumes it; ~reset_world restores the pose and sim time
+goes on; ~reset_simulation also sends sim time back to 0 (Gazebo's World::Reset)."""
 import math
 import sys
 import time
@@ -34,14 +35,28 @@ class ServicesTest(unittest.TestCase):
         call(SIM + "/unpause_physics")
         rec.wait(lambda: rec.last(rec.odom).pose.pose.position.x > x_paused + 0.05, 20.0, "motion after unpause")
         self.assertGreater(rec.last(rec.odom).pose.pose.position.x, 0.3)
-        # Reset: the robot goes back to its spawn pose; sim time keeps increasing.
+        # reset_world: the robot goes back to its spawn pose; sim time keeps increasing.
         before = rec.sim_time()
         rec.send(0.0, 0.0)
-        call(SIM + "/reset_simulation")
+        call(SIM + "/reset_world")
         msg = rec.odom_after(before + 0.2)
         p = msg.pose.pose.position
         self.assertLess(math.hypot(p.x, p.y), 0.01)
-        self.assertGreater(msg.header.stamp.to_sec(), before, "sim time does not jump back on reset")
+        self.assertGreater(msg.header.stamp.to_sec(), before, "sim time does not jump back on reset_world")
+        # reset_simulation: sim time starts again from 0 (the clock jumps back), the robot at its spawn pose.
+        rec.send_until_seen(0.5, 0.0)
+        rec.wait(lambda: rec.last(rec.odom).pose.pose.position.x > 0.2, 20.0, "motion before reset_simulation")
+        before = rec.sim_time()
+        rec.send(0.0, 0.0)
+        seen_clock, seen_odom = len(rec.snapshot(rec.clock)), len(rec.snapshot(rec.odom))
+        call(SIM + "/reset_simulation")
+        msg = rec.wait(lambda: next((m for m in rec.snapshot(rec.clock)[seen_clock:]
+                                     if m.clock.to_sec() < 0.5 * before), None),
+                       10.0, "/clock back near 0 after reset_simulation")
+        self.assertLess(msg.clock.to_sec(), 0.5 * before)
+        msg = rec.wait(lambda: next((m for m in rec.snapshot(rec.odom)[seen_odom:]
+                                     if m.header.stamp.to_sec() < 0.5 * before), None), 10.0, "odom after the reset")
+        self.assertLess(math.hypot(msg.pose.pose.position.x, msg.pose.pose.position.y), 0.05)
 
 
 if __name__ == "__main__":
