@@ -23,6 +23,14 @@ DEBS=(
   python3-laser-geometry
   # teleop.launch opens the teleop in its own terminal window
   xterm
+  # overlay/gazebo_msgs, overlay/controller_manager_msgs: message generation (gencpp/genpy/genlisp come with
+  # ros-message-generation), the C++ headers and CMake configs of the messages they use, and the .msg
+  # definitions themselves: Debian's lib*-msgs-dev CMake configs point at /usr/share/*/msg, which only the
+  # ros-*-msgs packages install. python3-trajectory-msgs: gazebo_msgs.srv.SetJointTrajectory imports it.
+  ros-message-generation ros-message-runtime
+  libstd-msgs-dev libgeometry-msgs-dev libsensor-msgs-dev libtrajectory-msgs-dev
+  ros-std-msgs ros-geometry-msgs ros-sensor-msgs ros-trajectory-msgs
+  python3-trajectory-msgs
 )
 
 log() { printf '[setup] %s\n' "$*"; }
@@ -81,12 +89,81 @@ for entry in package.xml CMakeLists.txt setup.py cmake src scripts launch urdf c
   fi
 done
 
+# overlay/ holds drop-in catkin packages for ROS 1 packages Debian does not ship (gazebo_msgs,
+# controller_manager_msgs, ...). Each directory with a package.xml is linked as catkin_ws/src/<name> ->
+# ../../overlay/<name>. DIFFBOT_SIM_OVERLAY=0 leaves them all out (for a machine with the real packages,
+# e.g. a Gazebo install) and removes links left by earlier runs.
+OVERLAY="$ROOT/overlay"
+overlay_pkgs=()
+if [ "${DIFFBOT_SIM_OVERLAY:-1}" != "0" ] && [ -d "$OVERLAY" ]; then
+  for d in "$OVERLAY"/*/; do
+    if [ -f "$d/package.xml" ]; then overlay_pkgs+=("$(basename "$d")"); fi
+  done
+fi
+is_linked() { [[ " ${overlay_pkgs[*]} " == *" $1 "* ]]; }
+# Drop links into overlay/ that are no longer wanted (opted out, or the package was removed).
+for link in "$WS"/src/*; do
+  if [ -L "$link" ] && [[ "$(readlink "$link")" == ../../overlay/* ]] && ! is_linked "$(basename "$link")"; then
+    rm -f "$link"
+  fi
+done
+for name in "${overlay_pkgs[@]}"; do
+  link="$WS/src/$name"
+  if [ "$(readlink "$link" 2>/dev/null)" != "../../overlay/$name" ]; then
+    if [ -e "$link" ] && [ ! -L "$link" ]; then
+      log "catkin_ws/src/$name exists and is not a link: leaving it, not linking overlay/$name"; continue
+    fi
+    ln -sfn "../../overlay/$name" "$link"
+  fi
+done
+if [ "${#overlay_pkgs[@]}" -gt 0 ]; then
+  log "overlay packages linked: ${overlay_pkgs[*]}"
+elif [ "${DIFFBOT_SIM_OVERLAY:-1}" = "0" ]; then
+  log "overlay packages linked: none (DIFFBOT_SIM_OVERLAY=0)"
+else
+  log "overlay packages linked: none"
+fi
+
 BUILD_STAMP="$WS/devel/.diffbot_built"
-if [ ! -f "$WS/devel/setup.bash" ] || [ -n "$(find "$ROOT/CMakeLists.txt" "$ROOT/package.xml" "$ROOT/setup.py" "$ROOT/cmake" \
-       -newer "$BUILD_STAMP" 2>/dev/null | head -1)" ] || [ ! -f "$BUILD_STAMP" ]; then
+# What the last build saw of overlay/: line 1 the linked packages, line 2 a hash of their files' paths and
+# mtimes. A file newer than the build, a new or deleted file, or another set of packages all rebuild.
+OVERLAY_STAMP="$WS/devel/.diffbot_overlay"
+overlay_sig() {
+  local name
+  for name in "${overlay_pkgs[@]}"; do
+    echo "package $name"
+    (cd "$OVERLAY" && find -L "$name" \( -name __pycache__ -o -name '*.pyc' -o -name '.*' \) -prune \
+       -o -type f -printf '%p %T@\n' 2>/dev/null || true) | LC_ALL=C sort
+  done | sha256sum | cut -d' ' -f1
+}
+want_overlay="${overlay_pkgs[*]}
+$(overlay_sig)"
+need_build=""
+if [ ! -f "$WS/devel/setup.bash" ] || [ ! -f "$BUILD_STAMP" ]; then
+  need_build=1
+elif [ "$(cat "$OVERLAY_STAMP" 2>/dev/null)" != "$want_overlay" ]; then
+  need_build=1
+elif [ -n "$(find "$ROOT/CMakeLists.txt" "$ROOT/package.xml" "$ROOT/setup.py" "$ROOT/cmake" -newer "$BUILD_STAMP" 2>/dev/null | head -1)" ]; then
+  need_build=1
+fi
+if [ -n "$need_build" ]; then
+  # An overlay package that left the workspace (DIFFBOT_SIM_OVERLAY=0, or removed) keeps its generated code
+  # and CMake config in devel/ and its cache entries in build/, where they would still shadow the real
+  # package: start from a clean build/ and devel/ then.
+  built_before="$(head -1 "$OVERLAY_STAMP" 2>/dev/null || true)"
+  for name in $built_before $(cd "$OVERLAY" 2>/dev/null && ls -d -- */ 2>/dev/null | tr -d /); do
+    if ! is_linked "$name" && { [ -e "$WS/devel/share/$name" ] || [ -e "$WS/build/$name" ]; }; then
+      log "$name left the workspace: cleaning $WS/build and $WS/devel"
+      rm -rf "$WS/build" "$WS/devel"
+      break
+    fi
+  done
   log "building $WS with catkin_make"
+  t0=$SECONDS
   (cd "$WS" && catkin_make -DPYTHON_EXECUTABLE="$VENV/bin/python" -DCATKIN_ENABLE_TESTING=ON >"$WS/catkin_make.log" 2>&1) || {
     tail -30 "$WS/catkin_make.log"; log "catkin_make failed (log: $WS/catkin_make.log)"; exit 1; }
   touch "$BUILD_STAMP"
+  printf '%s\n' "$want_overlay" > "$OVERLAY_STAMP"
+  log "built in $((SECONDS - t0)) s"
 fi
 log "ready: source $WS/devel/setup.bash"
