@@ -262,10 +262,61 @@ def probe_first_odom(options):
     print(json.dumps({"first_odom_epoch": first[0]}), flush=True)
 
 
-PROBES = {"count": probe_count, "rtf": probe_rtf, "latency": probe_latency, "first_odom": probe_first_odom}
+def probe_world_api(options):
+    """Spawn latency (spawn_urdf_model call -> first odom of the new robot, wall) and set_model_state round
+    trips, through the /gazebo services and gazebo_msgs' types, against a simulator started empty."""
+    import rospy
+    from gazebo_msgs.msg import ModelState
+    from gazebo_msgs.srv import SetModelState, SpawnModel
+    from geometry_msgs.msg import Pose, Twist
+    from nav_msgs.msg import Odometry
+    rospy.init_node("bench_world_api", disable_signals=True)
+    rospy.wait_for_service("/gazebo/spawn_urdf_model", 60)
+    spawn = rospy.ServiceProxy("/gazebo/spawn_urdf_model", SpawnModel, persistent=True)
+    set_state = rospy.ServiceProxy("/gazebo/set_model_state", SetModelState, persistent=True)
+    with open(options["model"]) as f:
+        urdf = f.read()
+    spawns = []
+    for i in range(options["spawns"]):
+        first = []
+        sub = rospy.Subscriber(f"/b{i}/odom", Odometry, lambda m, first=first: first or first.append(time.time()),
+                               queue_size=1)
+        pose = Pose()
+        pose.position.x, pose.position.y, pose.orientation.w = 2.0 * i, 0.0, 1.0
+        t0 = time.time()
+        resp = spawn(f"b{i}", urdf, f"/b{i}", pose, "world")
+        if not resp.success:
+            raise RuntimeError(resp.status_message)
+        _wait(lambda: first, 30, f"the first /b{i}/odom")
+        spawns.append(first[0] - t0)
+        sub.unregister()
+    trips = []
+    for i in range(options["round_trips"]):
+        state = ModelState("b0", Pose(), Twist(), "world")
+        state.pose.position.x, state.pose.position.y, state.pose.orientation.w = 0.0, 0.001 * (i % 100), 1.0
+        t0 = time.perf_counter()
+        resp = set_state(state)
+        trips.append(1000.0 * (time.perf_counter() - t0))
+        if not resp.success:
+            raise RuntimeError(resp.status_message)
+    print(json.dumps({"spawn_to_first_odom_s": spawns, "spawn_median_s": statistics.median(spawns),
+                      "set_model_state_p50_ms": percentile(trips, 50), "set_model_state_p99_ms": percentile(trips, 99),
+                      "round_trips": len(trips)}), flush=True)
+
+
+PROBES = {"count": probe_count, "rtf": probe_rtf, "latency": probe_latency, "first_odom": probe_first_odom,
+          "world_api": probe_world_api}
 
 
 # -------------------------------------------------------------------------------------------------- items
+
+def bench_world_api(spawns, round_trips):
+    """The simulator as empty_world.launch starts it (real time, no robot); robots spawned one by one."""
+    args = ["gazebo_ros", "empty_world.launch", "gui:=false"]
+    with Launch(args, "world_api") as launch:
+        return launch.probe("world_api", model=os.path.join(ROOT, "tests", "data", "robots", "fixed_caster.urdf"),
+                            spawns=spawns, round_trips=round_trips)
+
 
 def bench_bare(seconds):
     """The same model (xacro'd, loaded the way bullet_sim loads it) stepped by PyBullet alone."""
@@ -681,6 +732,11 @@ def table(r):
             value = (f"{s['max_robots_rtf_ge_1']} (real-time RTF {s['realtime_rtf_at_max']:.3f})"
                      if s["realtime_rtf_at_max"] else "0")
             rows.append((label, value, ">= 10" if key == "scale" else ""))
+    if r.get("world_api"):
+        w = r["world_api"]
+        rows += [("spawn_urdf_model -> first odom of the robot (median)", f"{w['spawn_median_s']:.3f} s", "<= 0.5 s"),
+                 ("set_model_state round trip p50 / p99 (real time)",
+                  f"{w['set_model_state_p50_ms']:.2f} / {w['set_model_state_p99_ms']:.2f} ms", "<= 5 ms")]
     width = max(len(name) for name, _, _ in rows)
     lines = [f"{'measure'.ljust(width)}  {'value':>28}  target", "-" * (width + 40)]
     lines += [f"{name.ljust(width)}  {value:>28}  {target}" for name, value, target in rows]
@@ -691,7 +747,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--probe", choices=sorted(PROBES), help=argparse.SUPPRESS)
     parser.add_argument("--options", default="{}", help=argparse.SUPPRESS)
-    parser.add_argument("--only", default="fast,realtime,latency,startup,scale,meshes,ros_control,worlds,sensors",
+    parser.add_argument("--only", default="fast,realtime,latency,startup,scale,meshes,ros_control,worlds,sensors,"
+                        "world_api",
                         help="comma-separated items to run (default: all)")
     parser.add_argument("--quick", action="store_true", help="shorter windows (smoke run, not for figures)")
     args = parser.parse_args()
@@ -709,7 +766,8 @@ def main():
              ("meshes", lambda: bench_meshes(1 if q else 3)),
              ("ros_control", lambda: bench_ros_control(4 if q else 12, 1 if q else 3)),
              ("worlds", lambda: bench_worlds(1 if q else 3, 4 if q else 10)),
-             ("sensors", lambda: bench_sensors(1 if q else 3, 4 if q else 10, 10 if q else 30))]
+             ("sensors", lambda: bench_sensors(1 if q else 3, 4 if q else 10, 10 if q else 30)),
+             ("world_api", lambda: bench_world_api(3 if q else 7, 100 if q else 1000))]
     for name, run in steps:
         wanted = name in items or (name == "scale_rsp" and "scale" in items)
         if not wanted:

@@ -356,9 +356,13 @@ class World:
         v = _point_velocity(linear, angular, [com[i] - pose[0][i] for i in range(3)])
         pybullet.resetBaseVelocity(uid, v, angular, physicsClientId=self.client)
 
-    def apply_wrench(self, uid, link, force, torque, point):
+    def apply_wrench(self, uid, link, force, torque, point=None):
         """Push body ``uid`` (PyBullet link index ``link``) for the coming step: ``force`` [N] at the world
-        ``point`` and ``torque`` [N·m], world axes (PyBullet clears external forces after each step)."""
+        ``point`` (None: the link's centre of mass, as Gazebo's Link::SetForce) and ``torque`` [N·m], world
+        axes (PyBullet clears external forces after each step)."""
+        if point is None:
+            point = (pybullet.getBasePositionAndOrientation(uid, physicsClientId=self.client)[0] if link == -1
+                     else pybullet.getLinkState(uid, link, physicsClientId=self.client)[0])
         if any(force):
             pybullet.applyExternalForce(uid, link, force, point, pybullet.WORLD_FRAME, physicsClientId=self.client)
         if any(torque):

@@ -72,7 +72,9 @@ class _Robot:
         self.model = runtime.ctx.model
 
     def links(self):
-        return list(self.model.links)
+        """The links Gazebo keeps: the root and every child of a moving joint (fixed-joint children are
+        lumped into their parent, as Gazebo's URDF reader does); lumped links still answer ``motion``."""
+        return [self.model.root] + [j.child for j in self.model.joints.values() if j.type != "fixed"]
 
     def motion(self, link=None):
         """(pose, linear, angular) of a link frame (the root: the model), world axes."""
@@ -156,7 +158,10 @@ class GazeboApi:
         return math.inf
 
     def before_step(self, now):
-        for body, force, torque, point in self.wrenches.active(now):
+        """Wrenches due during the coming step (Gazebo's scheduler runs at the time the step reaches)."""
+        if not len(self.wrenches):
+            return
+        for body, force, torque, point in self.wrenches.active(now + self.cfg.time_step):
             model, link = world_api.split_link_name(body)
             entity = self.models().get(model)
             if entity is None:
@@ -206,16 +211,13 @@ class GazeboApi:
 
     def _frame_motion(self, frame, what):
         """World (pose, linear, angular) of a reference frame: a model or a ``model::link``; None: world."""
+        model, link = frame.rsplit("::", 1) if "::" in frame else (frame, None)
+        entity = self.models().get(model)
+        if entity is not None and (link is None or link in entity.links()):
+            return entity.motion(link)  # an entity first, as upstream: a model named "map" wins
         if world_api.is_world_frame(frame):
             return None
-        model, link = (frame.rsplit("::", 1) + [None])[:2] if "::" in frame else (frame, None)
-        entity = self.models().get(model)
-        try:
-            if entity is None:
-                raise KeyError(frame)
-            return entity.motion(link)
-        except KeyError:
-            raise RequestError(f"{what} '{frame}' not found: not a model nor a model::link") from None
+        raise RequestError(f"{what} '{frame}' not found: not a model nor a model::link")
 
     def _relative(self, motion, frame_motion):
         pose, linear, angular = motion
@@ -228,7 +230,9 @@ class GazeboApi:
         if frame_motion is None:
             return pose, twist
         fpose, flin, fang = frame_motion
-        return world_api.world_state(pose, twist, fpose, (flin, fang))
+        # SetModelState's convention for both services: the twist's directions are read in the frame's axes
+        # (SetLinkState upstream subtracts the frame velocity unrotated, a bug not copied).
+        return world_api.world_state(pose, twist, fpose, (flin, fang), world_api.SET_MODEL_STATE)
 
     # -- ROS side ------------------------------------------------------------------------------------
     def advertise(self):
@@ -353,7 +357,7 @@ class GazeboApi:
         pose = world_api.check_pose(_pose_tuple(pose_msg), "pose")
         twist = world_api.check_twist(_twist_tuple(twist_msg), "twist")
         frame = self._frame_motion(frame_name, "reference_frame")
-        pose, (linear, angular) = self._absolute(pose, twist, frame)
+        pose, (linear, angular) = self._absolute(pose, twist, frame)  # directions turned, as SetModelState
         entity.set_motion(pose, linear, angular, link)
 
     def _set_model_state(self, req):
@@ -430,8 +434,7 @@ class GazeboApi:
                 model = entity.model
                 response.canonical_body_name = model.root
                 response.joint_names = [j.name for j in model.joints.values() if j.type != "fixed"]
-                response.geom_names = [f"{link}_collision" for link in entity.links()
-                                       if getattr(model.links[link], "collisions", None)]
+                response.geom_names = [f"{link}_collision" for link in entity.links()]
             response.is_static = entity.static
             return "GetModelProperties: got properties"
         return self._run(action, response)
@@ -501,8 +504,7 @@ class GazeboApi:
             if not all(math.isfinite(v) for v in force + torque + point):
                 raise RequestError("ApplyBodyWrench: wrench and reference_point must be finite")
             body_pose = entity.motion(link)[0]
-            frame_pose = body_pose if frame is None and not world_api.is_world_frame(req.reference_frame) \
-                else (frame[0] if frame is not None else None)
+            frame_pose = frame[0] if frame is not None else None
             force, torque, point = world_api.wrench_to_world(force, torque, point, frame_pose, body_pose)
             self.wrenches.add(req.body_name, force, torque, point, req.start_time.to_sec(),
                               req.duration.to_sec(), self.sim.sim_time)

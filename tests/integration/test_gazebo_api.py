@@ -1,0 +1,317 @@
+#!/usr/bin/env python3
+"""The /gazebo world API through gazebo_msgs' own types, as user scripts (tests, RL resets, mission scripts)
+call it: spawn a robot at run time that then drives, teleport it and drive from there, delete it while it
+drives (its topics go), world models, link states, wrenches, physics properties, both resets, and bad
+requests answered with success false and a reason while the simulator runs on.
+
+The simulator starts as empty_world.launch starts it (node ``gazebo``, no robot) in tests/data/worlds/walls.world
+(its models: box_wall, pillar, ring, moved_by_state, push_box (dynamic, a 0.3 kg 0.3 m cube at (1.15, 15, 0.15)),
+fixed_box, platform, ground_plane). The robot is tests/data/robots/fixed_caster.urdf (ROS 1 diff drive:
+cmd_vel, odom in its plugin's robotNamespace).
+"""
+import math
+import os
+import sys
+import threading
+import time
+import unittest
+
+import rosgraph
+import rospy
+import rostest
+from gazebo_msgs import msg as gmsg
+from gazebo_msgs import srv as gsrv
+from geometry_msgs.msg import Point, Pose, Quaternion, Twist, Wrench, Vector3
+from nav_msgs.msg import Odometry
+from std_srvs.srv import Empty
+
+GZ = "/gazebo"
+ROBOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "robots", "fixed_caster.urdf")
+
+
+def proxy(name, kind):
+    rospy.wait_for_service(f"{GZ}/{name}", 30.0)
+    return rospy.ServiceProxy(f"{GZ}/{name}", kind)
+
+
+def pose(x=0.0, y=0.0, z=0.0, yaw=0.0):
+    return Pose(Point(x, y, z), Quaternion(0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)))
+
+
+def yaw_of(q):
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def wait(predicate, timeout, what):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and not rospy.is_shutdown():
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.02)
+    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+
+
+class Latest:
+    """The newest message of a topic (callbacks only store)."""
+
+    def __init__(self, topic, kind):
+        self.lock = threading.Lock()
+        self.msg, self.count = None, 0
+        self.sub = rospy.Subscriber(topic, kind, self._keep, queue_size=10)
+
+    def _keep(self, msg):
+        with self.lock:
+            self.msg, self.count = msg, self.count + 1
+
+    def get(self):
+        with self.lock:
+            return self.msg
+
+
+def publishers_of(topic):
+    """Nodes the master lists as publishing ``topic``."""
+    state = rosgraph.Master("/test_gazebo_api").getSystemState()
+    return next((nodes for name, nodes in state[0] if name == topic), [])
+
+
+class GazeboApiTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_gazebo_api")
+        with open(ROBOT) as f:
+            cls.urdf = f.read()
+        cls.spawn = proxy("spawn_urdf_model", gsrv.SpawnModel)
+        cls.spawn_sdf = proxy("spawn_sdf_model", gsrv.SpawnModel)
+        cls.delete = proxy("delete_model", gsrv.DeleteModel)
+        cls.get_state = proxy("get_model_state", gsrv.GetModelState)
+        cls.set_state = proxy("set_model_state", gsrv.SetModelState)
+        cls.world = proxy("get_world_properties", gsrv.GetWorldProperties)
+        cls.props = proxy("get_model_properties", gsrv.GetModelProperties)
+
+    def spawn_robot(self, name, ns, x, y, yaw):
+        resp = self.spawn(name, self.urdf, ns, pose(x, y, 0.0, yaw), "world")
+        self.assertTrue(resp.success, resp.status_message)
+        return resp
+
+    def drive(self, ns, linear, angular, seconds_sim):
+        """Publish a command on ``ns``/cmd_vel until sim time has advanced by ``seconds_sim``."""
+        pub = rospy.Publisher(f"{ns}/cmd_vel", Twist, queue_size=1)
+        wait(lambda: pub.get_num_connections() > 0, 10.0, f"{ns}/cmd_vel subscriber")
+        start = rospy.get_time()
+        cmd = Twist()
+        cmd.linear.x, cmd.angular.z = linear, angular
+        deadline = time.monotonic() + 60.0
+        while rospy.get_time() < start + seconds_sim and time.monotonic() < deadline:
+            pub.publish(cmd)
+            time.sleep(0.05)
+        pub.publish(Twist())
+        return pub
+
+    def model(self, name, frame=""):
+        resp = self.get_state(name, frame)
+        self.assertTrue(resp.success, resp.status_message)
+        return resp
+
+    # -- tests ---------------------------------------------------------------------------------------
+    def test_01_world_properties_list_the_world_models(self):
+        resp = self.world()
+        self.assertTrue(resp.success)
+        for name in ("ground_plane", "box_wall", "push_box", "platform"):
+            self.assertIn(name, resp.model_names)
+        self.assertGreater(resp.sim_time, 0.0)
+        box = self.model("push_box")
+        self.assertAlmostEqual(box.pose.position.x, 1.15, delta=0.02)
+        self.assertAlmostEqual(box.pose.position.y, 15.0, delta=0.02)
+        props = self.props("box_wall")
+        self.assertTrue(props.success and props.is_static, props)
+
+    def test_02_spawn_at_run_time_then_drive(self):
+        """A robot spawned at (2, -3) facing +y with robot_namespace /bot1 publishes /bot1/odom and drives
+        along +y when told to go forward."""
+        self.spawn_robot("bot1", "/bot1", 2.0, -3.0, math.pi / 2)
+        odom = Latest("/bot1/odom", Odometry)
+        wait(odom.get, 10.0, "/bot1/odom after the spawn")
+        start = self.model("bot1")
+        self.assertAlmostEqual(start.pose.position.x, 2.0, delta=0.02)
+        self.assertAlmostEqual(start.pose.position.y, -3.0, delta=0.02)
+        self.assertAlmostEqual(yaw_of(start.pose.orientation), math.pi / 2, delta=0.02)
+        self.drive("/bot1", 0.3, 0.0, 2.0)
+        end = self.model("bot1")
+        self.assertGreater(end.pose.position.y - start.pose.position.y, 0.3)
+        self.assertLess(abs(end.pose.position.x - start.pose.position.x), 0.1)
+        self.assertIn("bot1", self.world().model_names)
+        props = self.props("bot1")
+        self.assertEqual(props.canonical_body_name, "base_footprint")
+        self.assertEqual(sorted(props.body_names), ["base_footprint", "left_wheel_link", "right_wheel_link"])
+        self.assertIn("left_wheel_joint", props.joint_names)
+        self.assertFalse(props.is_static)
+
+    def test_03_spawn_refusals_keep_the_simulator_running(self):
+        self.spawn_robot("bot_dup", "/bot_dup", -3.0, -3.0, 0.0)
+        cases = [
+            (gsrv.SpawnModelRequest("bot_dup", self.urdf, "/x", pose(-5, -5), ""), "already exists"),
+            (gsrv.SpawnModelRequest("bad_xml", "<robot name='x'><link name='a'>", "", pose(-6, -6), ""), "xml"),
+            (gsrv.SpawnModelRequest("nan_pose", self.urdf, "/n", pose(float("nan"), 0), ""), "nan"),
+            (gsrv.SpawnModelRequest("no_frame", self.urdf, "/f", pose(-7, -7), "no_such_model"), "no_such_model"),
+            (gsrv.SpawnModelRequest("pkg", self.urdf.replace("<robot", "<robot><link name='m'><visual><geometry>"
+                                    "<mesh filename='package://no_such_pkg_xyz/m.stl'/></geometry></visual></link"
+                                    "><!--", 1).replace("</robot>", "--></robot>"), "", pose(-8, -8), ""),
+             "no_such_pkg_xyz"),
+        ]
+        for request, needle in cases:
+            resp = self.spawn(request)
+            self.assertFalse(resp.success, request.model_name)
+            self.assertIn(needle.lower(), resp.status_message.lower(), resp.status_message)
+        for name in ("bad_xml", "nan_pose", "no_frame", "pkg"):
+            self.assertNotIn(name, self.world().model_names)
+        missing = self.get_state("no_such_model", "")
+        self.assertFalse(missing.success)
+        self.assertIn("does not exist", missing.status_message)
+        before = self.world().sim_time
+        wait(lambda: self.world().sim_time > before + 0.2, 10.0, "sim time going on after refusals")
+
+    def test_04_set_model_state_teleports_then_drives_from_there(self):
+        self.spawn_robot("bot_tp", "/bot_tp", -2.0, 3.0, 0.0)
+        odom = Latest("/bot_tp/odom", Odometry)
+        wait(odom.get, 10.0, "/bot_tp/odom")
+        state = gmsg.ModelState("bot_tp", pose(4.0, -6.0, 0.0, math.pi), Twist(), "world")
+        resp = self.set_state(state)
+        self.assertTrue(resp.success, resp.status_message)
+        there = self.model("bot_tp")
+        self.assertAlmostEqual(there.pose.position.x, 4.0, delta=0.03)
+        self.assertAlmostEqual(there.pose.position.y, -6.0, delta=0.03)
+        self.drive("/bot_tp", 0.3, 0.0, 2.0)
+        end = self.model("bot_tp")
+        self.assertLess(end.pose.position.x, 4.0 - 0.3, "facing -x after the teleport, it drives towards -x")
+        self.assertAlmostEqual(end.pose.position.y, -6.0, delta=0.1)
+        # relative to another model: bot_tp seen from push_box (yaw 0)
+        box = self.model("push_box").pose.position
+        rel = self.model("bot_tp", "push_box")
+        self.assertAlmostEqual(rel.pose.position.x, end.pose.position.x - box.x, delta=0.05)
+        self.assertAlmostEqual(rel.pose.position.y, end.pose.position.y - box.y, delta=0.05)
+        # the topic form, with a reference frame: 1 m ahead of push_box
+        pub = rospy.Publisher(f"{GZ}/set_model_state", gmsg.ModelState, queue_size=1)
+        wait(lambda: pub.get_num_connections() > 0, 10.0, "set_model_state topic subscriber")
+        pub.publish(gmsg.ModelState("bot_tp", pose(-3.0, -2.0, 0.0), Twist(), "push_box"))
+        wait(lambda: abs(self.model("bot_tp").pose.position.x - (box.x - 3.0)) < 0.05, 10.0,
+             "bot_tp moved by the set_model_state topic relative to push_box")
+        bad = self.set_state(gmsg.ModelState("bot_tp", pose(0, 0, float("inf")), Twist(), ""))
+        self.assertFalse(bad.success)
+        bad = self.set_state(gmsg.ModelState("nobody", pose(), Twist(), ""))
+        self.assertFalse(bad.success)
+        self.assertIn("nobody", bad.status_message)
+
+    def test_05_delete_while_driving_removes_its_topics(self):
+        self.spawn_robot("bot_del", "/bot_del", 5.0, 5.0, 0.0)
+        odom = Latest("/bot_del/odom", Odometry)
+        wait(odom.get, 10.0, "/bot_del/odom")
+        self.assertTrue(publishers_of("/bot_del/odom"))
+        pub = rospy.Publisher("/bot_del/cmd_vel", Twist, queue_size=1)
+        wait(lambda: pub.get_num_connections() > 0, 10.0, "/bot_del/cmd_vel subscriber")
+        cmd = Twist()
+        cmd.linear.x = 0.3
+        pub.publish(cmd)
+        resp = self.delete("bot_del")
+        self.assertTrue(resp.success, resp.status_message)
+        self.assertNotIn("bot_del", self.world().model_names)
+        wait(lambda: not publishers_of("/bot_del/odom"), 10.0, "/bot_del/odom unregistered")
+        count = odom.count
+        pub.publish(cmd)
+        time.sleep(0.5)  # observing that nothing arrives: a bounded look, not a wait for a condition
+        self.assertLessEqual(odom.count, count + 1)
+        again = self.delete("bot_del")
+        self.assertFalse(again.success)
+        before = self.world().sim_time
+        wait(lambda: self.world().sim_time > before + 0.2, 10.0, "sim time going on after the delete")
+        # the name is free again
+        self.spawn_robot("bot_del", "/bot_del", 5.0, 5.0, 0.0)
+        self.assertTrue(self.delete("bot_del").success)
+
+    def test_06_model_and_link_states_topics(self):
+        self.spawn_robot("bot_ls", "/bot_ls", -4.0, 8.0, 0.0)
+        states = Latest(f"{GZ}/model_states", gmsg.ModelStates)
+        links = Latest(f"{GZ}/link_states", gmsg.LinkStates)
+        msg = wait(lambda: (m := states.get()) is not None and "bot_ls" in m.name and m, 10.0, "model_states")
+        i = msg.name.index("bot_ls")
+        self.assertAlmostEqual(msg.pose[i].position.x, -4.0, delta=0.03)
+        self.assertIn("push_box", msg.name)
+        lmsg = wait(lambda: (m := links.get()) is not None and "bot_ls::base_footprint" in m.name and m, 10.0,
+                    "link_states")
+        self.assertIn("bot_ls::left_wheel_link", lmsg.name)
+        get_link = proxy("get_link_state", gsrv.GetLinkState)
+        resp = get_link("bot_ls::base_footprint", "world")
+        self.assertTrue(resp.success, resp.status_message)
+        self.assertAlmostEqual(resp.link_state.pose.position.x, -4.0, delta=0.03)
+        set_link = proxy("set_link_state", gsrv.SetLinkState)
+        resp = set_link(gmsg.LinkState("bot_ls::base_footprint", pose(-4.0, 9.0), Twist(), "world"))
+        self.assertTrue(resp.success, resp.status_message)
+        self.assertAlmostEqual(self.model("bot_ls").pose.position.y, 9.0, delta=0.03)
+        self.assertFalse(get_link("bot_ls::no_link", "").success)
+        self.assertFalse(get_link("nolinkname", "").success)
+        states.sub.unregister()
+        links.sub.unregister()
+        self.delete("bot_ls")
+
+    def test_07_wrench_pushes_a_dynamic_box(self):
+        apply = proxy("apply_body_wrench", gsrv.ApplyBodyWrench)
+        clear = proxy("clear_body_wrenches", gsrv.BodyRequest)
+        start = self.model("push_box").pose.position.x
+        wrench = Wrench(Vector3(0.0, 40.0, 0.0), Vector3())
+        resp = apply("push_box::link", "world", Point(), wrench, rospy.Time(0), rospy.Duration(-1))
+        self.assertTrue(resp.success, resp.status_message)
+        wait(lambda: self.model("push_box").twist.linear.y > 0.05, 20.0, "push_box moving along +y")
+        clear("push_box::link")
+        self.assertAlmostEqual(self.model("push_box").pose.position.x, start, delta=0.1)
+        bad = apply("push_box::nolink", "world", Point(), wrench, rospy.Time(0), rospy.Duration(1))
+        self.assertFalse(bad.success)
+
+    def test_08_physics_properties_pause_and_resets(self):
+        physics = proxy("get_physics_properties", gsrv.GetPhysicsProperties)()
+        self.assertTrue(physics.success)
+        self.assertAlmostEqual(physics.time_step, 1.0 / 240.0, places=9)
+        self.assertFalse(physics.pause)
+        self.assertAlmostEqual(physics.gravity.z, -9.8, delta=0.02)
+        rospy.ServiceProxy(f"{GZ}/pause_physics", Empty)()
+        self.assertTrue(proxy("get_physics_properties", gsrv.GetPhysicsProperties)().pause)
+        t0 = self.world().sim_time
+        time.sleep(0.3)  # observing that time stands: a bounded look
+        self.assertEqual(self.world().sim_time, t0)
+        rospy.ServiceProxy(f"{GZ}/unpause_physics", Empty)()
+        wait(lambda: self.world().sim_time > t0 + 0.1, 10.0, "sim time after unpause")
+        # reset_world: models back to where they started; time goes on
+        self.spawn_robot("bot_rs", "/bot_rs", 7.0, -7.0, 0.0)
+        self.set_state(gmsg.ModelState("bot_rs", pose(7.0, -5.0), Twist(), ""))
+        t1 = self.world().sim_time
+        rospy.ServiceProxy(f"{GZ}/reset_world", Empty)()
+        self.assertAlmostEqual(self.model("bot_rs").pose.position.y, -7.0, delta=0.03)
+        self.assertGreaterEqual(self.world().sim_time, t1)
+        # reset_simulation: also sim time back to 0
+        rospy.ServiceProxy(f"{GZ}/reset_simulation", Empty)()
+        self.assertLess(self.world().sim_time, t1)
+        self.delete("bot_rs")
+
+    def test_09_spawn_sdf_model(self):
+        box = ('<?xml version="1.0"?><sdf version="1.6"><model name="anything"><link name="link">'
+               '<inertial><mass>2</mass></inertial><collision name="c"><geometry><box><size>0.4 0.4 0.4</size>'
+               '</box></geometry></collision></link></model></sdf>')
+        resp = self.spawn_sdf("goal", box, "", pose(3.0, 12.0, 1.0), "world")
+        self.assertTrue(resp.success, resp.status_message)
+        self.assertIn("goal", self.world().model_names)
+        wait(lambda: abs(self.model("goal").pose.position.z - 0.2) < 0.02, 10.0, "the box falling onto the ground")
+        self.assertAlmostEqual(self.model("goal").pose.position.x, 3.0, delta=0.02)
+        self.assertFalse(self.spawn_sdf("goal", box, "", pose(), "").success)
+        self.assertTrue(self.delete("goal").success)
+        self.assertNotIn("goal", self.world().model_names)
+
+    def test_10_set_model_configuration(self):
+        self.spawn_robot("bot_cfg", "/bot_cfg", 8.0, 8.0, 0.0)
+        configure = proxy("set_model_configuration", gsrv.SetModelConfiguration)
+        resp = configure("bot_cfg", "", ["left_wheel_joint"], [1.0])
+        self.assertTrue(resp.success, resp.status_message)
+        self.assertFalse(configure("bot_cfg", "", ["no_joint"], [1.0]).success)
+        self.delete("bot_cfg")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("diffbot_sim", "test_gazebo_api", GazeboApiTest, sys.argv)

@@ -1,0 +1,131 @@
+#!/usr/bin/env python3
+"""A user's launch file written for Gazebo (tests/data/gazebo_way/*.launch) runs unchanged: the world loads,
+each robot spawns at its pose, its controllers start through controller_manager's spawner, its
+mobile_base_controller/cmd_vel drives it (and no other robot), its laser sees the wall.
+
+Parameters: ~robots: [{model: NAME, ns: NAMESPACE ("" for the root), x: X, y: Y}] as the launch file spawns
+them, all facing +y; the wall's near face is the plane y = 5 (wall.world).
+"""
+import math
+import sys
+import threading
+import time
+import unittest
+
+import rospy
+import rostest
+from controller_manager_msgs.srv import ListControllers
+from gazebo_msgs.srv import GetModelState, GetWorldProperties
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import JointState, LaserScan
+
+WALL_Y = 5.0
+
+
+def yaw_of(q):
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def wait(predicate, timeout, what):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and not rospy.is_shutdown():
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.05)
+    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+
+
+class Latest:
+    def __init__(self, topic, kind):
+        self.lock = threading.Lock()
+        self.msg = None
+        self.sub = rospy.Subscriber(topic, kind, self._keep, queue_size=5)
+
+    def _keep(self, msg):
+        with self.lock:
+            self.msg = msg
+
+    def get(self):
+        with self.lock:
+            return self.msg
+
+
+class GazeboWayTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_gazebo_way")
+        cls.robots = rospy.get_param("~robots")
+        rospy.wait_for_service("/gazebo/get_model_state", 60.0)
+        cls.get_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+
+    def state(self, model):
+        resp = self.get_state(model, "world")
+        self.assertTrue(resp.success, resp.status_message)
+        return resp
+
+    def test_1_spawned_at_the_pose_with_controllers_running(self):
+        world = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
+        names = wait(lambda: (n := world().model_names) and all(r["model"] in n for r in self.robots) and n,
+                     60.0, "every robot spawned")
+        self.assertIn("wall", names)
+        for robot in self.robots:
+            s = self.state(robot["model"])
+            self.assertAlmostEqual(s.pose.position.x, robot["x"], delta=0.05)
+            self.assertAlmostEqual(s.pose.position.y, robot["y"], delta=0.05)
+            self.assertAlmostEqual(yaw_of(s.pose.orientation), 1.57, delta=0.03)
+            ns = robot["ns"]
+            service = f"{ns}/controller_manager/list_controllers"
+            rospy.wait_for_service(service, 30.0)
+            listing = rospy.ServiceProxy(service, ListControllers)
+
+            def running():
+                states = {c.name: c.state for c in listing().controller}
+                return states.get("mobile_base_controller") == "running" and \
+                    states.get("joint_state_controller") == "running" and states
+            states = wait(running, 60.0, f"{ns} controllers running (spawner)")
+            self.assertEqual(len(states), 2)
+            joints = Latest(f"{ns}/joint_states", JointState)
+            msg = wait(joints.get, 10.0, f"{ns}/joint_states")
+            self.assertIn("front_left_wheel_joint", msg.name)
+
+    def test_2_laser_sees_the_wall(self):
+        for robot in self.robots:
+            scan = Latest(f"{robot['ns']}/scan", LaserScan)
+            msg = wait(scan.get, 20.0, f"{robot['ns']}/scan")
+            middle = msg.ranges[len(msg.ranges) // 2]
+            s = self.state(robot["model"])
+            expected = WALL_Y - s.pose.position.y
+            # the middle ray of an even sample count is half an increment off the heading
+            self.assertAlmostEqual(middle, expected / math.cos(msg.angle_increment / 2), delta=0.05)
+
+    def test_3_cmd_vel_drives_only_its_robot(self):
+        for robot in self.robots:
+            ns = robot["ns"]
+            odom = Latest(f"{ns}/mobile_base_controller/odom", Odometry)
+            wait(odom.get, 20.0, f"{ns}/mobile_base_controller/odom")
+            others = {r["model"]: self.state(r["model"]).pose.position for r in self.robots if r is not robot}
+            start = self.state(robot["model"]).pose.position
+            pub = rospy.Publisher(f"{ns}/mobile_base_controller/cmd_vel", Twist, queue_size=1)
+            wait(lambda: pub.get_num_connections() > 0, 10.0, f"{ns}/mobile_base_controller/cmd_vel subscriber")
+            cmd = Twist()
+            cmd.linear.x = 0.4
+            t0 = rospy.get_time()
+            deadline = time.monotonic() + 60.0
+            while rospy.get_time() < t0 + 2.0 and time.monotonic() < deadline:
+                pub.publish(cmd)  # the YAML's cmd_vel_timeout is 0.25 s: keep commanding
+                time.sleep(0.05)
+            pub.publish(Twist())
+            end = self.state(robot["model"]).pose.position
+            self.assertGreater(end.y - start.y, 0.4, f"{robot['model']} drove forward (+y)")
+            self.assertLess(end.y, WALL_Y - 0.2)
+            self.assertGreater(odom.get().pose.pose.position.x, 0.3, "controller odometry counts forward")
+            for name, position in others.items():
+                now = self.state(name).pose.position
+                self.assertLess(math.hypot(now.x - position.x, now.y - position.y), 0.02, f"{name} stayed")
+            pub.unregister()
+
+
+if __name__ == "__main__":
+    rostest.rosrun("diffbot_sim", "test_gazebo_way", GazeboWayTest, sys.argv)
