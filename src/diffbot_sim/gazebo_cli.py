@@ -387,9 +387,10 @@ def controller_type_param(namespace, controller):
 def read_controller_file(path):
     """A controller YAML file given to the spawner: (controller names, the parsed mapping).
 
-    The noetic spawner treats any argument naming an existing path as such a file: it puts the file's content
-    on the parameter server (in the node's namespace, merged key by key as ``rosparam.set_param`` does)
-    and loads each top-level key as a controller. Raises CliError naming the file when it is not a YAML
+    The noetic spawner treats an argument naming an existing path as such a file: it puts the file's content
+    on the parameter server (merged key by key as ``rosparam.set_param`` does; the node uploads it where the
+    controller manager reads it, see :mod:`diffbot_sim.nodes.controller_spawner`) and loads each top-level
+    key as a controller. Raises CliError naming the file when it is not a YAML
     mapping.
     """
     try:
@@ -408,11 +409,12 @@ def read_controller_file(path):
     return list(data), data
 
 
-def expand_controllers(names, exists=os.path.exists, read=read_controller_file):
+def expand_controllers(names, exists=os.path.isfile, read=read_controller_file):
     """The spawner's arguments as (controller names to load, [(file, mapping) to upload first]).
 
-    An argument naming an existing path is a YAML file (see :func:`read_controller_file`); any other is a
-    controller name. Order is kept.
+    An argument naming an existing file is a YAML file (see :func:`read_controller_file`); any other is a
+    controller name. Order is kept. (Noetic tests ``os.path.exists``, so a directory that happens to have a
+    controller's name in the working directory crashes it; a file test avoids that.)
     """
     controllers, files = [], []
     for name in names:

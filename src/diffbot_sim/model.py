@@ -198,6 +198,8 @@ def parse_urdf(text, source="robot_description"):
     for el in root.findall("link"):
         lname = _required(el, "name", source, "/robot/link")
         path = f"/robot/link[@name='{lname}']"
+        if lname in links:  # urdfdom refuses the model; PyBullet would crash on it
+            raise ModelError(f"link '{lname}' is not unique (a second <link> of that name)", source, path)
         mass = None
         inertial = el.find("inertial")
         if inertial is not None:
@@ -216,6 +218,8 @@ def parse_urdf(text, source="robot_description"):
     for el in root.findall("joint"):
         jname = _required(el, "name", source, "/robot/joint")
         path = f"/robot/joint[@name='{jname}']"
+        if jname in joints:
+            raise ModelError(f"joint '{jname}' is not unique (a second <joint> of that name)", source, path)
         jtype = _required(el, "type", source, path)
         parent = _link_ref(el, "parent", links, source, path)
         child = _link_ref(el, "child", links, source, path)

@@ -238,3 +238,16 @@ def test_transmission_round_trips(n, offset):
     assert (trans.actuator_to_joint_effort(2.0) * trans.actuator_to_joint_velocity(3.0)
             == pytest.approx(2.0 * 3.0))
     assert math.isfinite(trans.actuator_to_joint_velocity(1.0))
+
+
+@pytest.mark.parametrize("extra, culprit", [
+    ('<link name="a"/>', "/robot/link[@name='a']"),
+    ('<link name="c"/><joint name="j" type="fixed"><parent link="a"/><child link="c"/></joint>', "/robot/joint[@name='j']"),
+])
+def test_a_duplicate_link_or_joint_name_is_refused_by_name(extra, culprit):
+    """urdfdom refuses a second link or joint of one name (PyBullet would crash on it): one line naming it."""
+    text = ('<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="fixed"><parent link="a"/>'
+            f'<child link="b"/></joint>{extra}</robot>')
+    with pytest.raises(ModelError) as err:
+        parse_urdf(text, "dup.urdf")
+    assert "not unique" in str(err.value) and culprit in str(err.value) and "dup.urdf" in str(err.value)

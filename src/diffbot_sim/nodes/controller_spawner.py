@@ -13,8 +13,8 @@ timeout), ``<cm>/unload_controller`` (UnloadController: name), ``<cm>/list_contr
 
 * ``spawner``: waits for load/switch/unload (``--timeout`` each; with sim time and no /clock yet it keeps
   waiting, as noetic), optionally for ``True`` on ``--wait-for``, loads every controller (a YAML file
-  argument is uploaded and its top-level keys loaded), starts them in one STRICT switch unless
-  ``--stopped``, spins; at shutdown stops and unloads what it loaded.
+  argument is uploaded where the controller manager reads it, and its top-level keys loaded), starts them
+  in one STRICT switch unless ``--stopped``, spins; at shutdown stops and unloads what it loaded.
 * ``unspawner NAME...``: stops the named running controllers (again every 3 s), restarts them at shutdown.
 * ``controller_manager VERB NAME...``: one-shot calls, printing as noetic's script does.
 """
@@ -125,9 +125,14 @@ class Spawner:
             return 1
         if self.args.wait_for and not self._wait_for_topic():
             return 0
+        # Where the controller manager reads its controllers' configuration: --namespace, or this node's
+        # namespace. (Noetic uploads to the node's namespace even with --namespace, where the manager then
+        # finds nothing; where the two agree, this is the same.)
+        prefix = gazebo_cli.manager_prefix(self.args.namespace)
+        where = rospy.resolve_name(prefix) if prefix else rospy.get_namespace()
         for path, data in self.files:
-            rospy.loginfo(f"Controller Spawner: uploading {path} to the parameter server")
-            for name, value in gazebo_cli.flatten_params(data):
+            rospy.loginfo(f"Controller Spawner: uploading {path} to the parameter server under {where}")
+            for name, value in gazebo_cli.flatten_params(data, prefix):
                 rospy.set_param(name, value)
         rospy.on_shutdown(self.shutdown)
         for name in self.controllers:

@@ -30,6 +30,8 @@ from .. import gazebo_cli
 from ..gazebo_cli import CliError, UsageExit
 
 NODE_NAME = "spawn_model"
+#: How often ``-wait`` checks for its model (s, wall time): upstream's 10 Hz.
+WAIT_PERIOD = 0.1
 
 
 class SpawnFailed(Exception):
@@ -85,12 +87,10 @@ def _wait_for_model(args):
 
     sub = rospy.Subscriber(args.service("model_states"), ModelStates, on_states, queue_size=1)
     rospy.loginfo(f"Waiting for model {args.wait} before proceeding.")
-    rate = rospy.Rate(10)
     try:
-        while not rospy.is_shutdown() and not seen.is_set():
-            rate.sleep()
-    except rospy.ROSInterruptException:
-        return False
+        # 10 Hz in wall time: upstream's rospy.Rate runs on sim time, which stands still without /clock.
+        while not rospy.is_shutdown() and not seen.wait(WAIT_PERIOD):
+            pass
     finally:
         sub.unregister()
     return seen.is_set()
