@@ -3,7 +3,7 @@ SHELL := /bin/bash
 ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
 ENV := $(ROOT)/tools/rosenv.sh
 
-.PHONY: setup run test test-slow unit bench clean
+.PHONY: setup run test test-slow unit bench pictures clean
 
 setup:
 	@bash $(ROOT)/tools/setup.sh
@@ -20,6 +20,11 @@ test-slow: setup
 # Speed, latency, start-up and scale figures (tools/bench.py; ~6 min; writes bench-results/bench.json).
 bench: setup
 	@bash $(ENV) python3 $(ROOT)/tools/bench.py
+
+# The README's pictures (docs/rviz.png, docs/run.png, docs/pybullet.png) from a scripted run under Xvfb, and
+# the rviz first-frame figure (tools/pictures.py; about 1 min).
+pictures: setup
+	@bash $(ENV) python3 $(ROOT)/tools/pictures.py
 
 unit: setup
 	@bash $(ENV) python3 -m pytest -q $(ROOT)/tests/unit

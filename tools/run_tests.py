@@ -120,6 +120,8 @@ def run_rostest(test_file):
     os.makedirs(base)
     log_path = os.path.join(base, "console.log")
     started = time.monotonic()
+    if name.startswith("slow_"):  # minutes without a line otherwise: say that it runs
+        say(f"[tests] rostest {name}: started (a slow suite, minutes; log {log_path})")
     env = user_env(ROS_HOME=os.path.join(base, "ros_home"))
     with open(log_path, "w") as log:
         try:

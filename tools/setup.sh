@@ -31,6 +31,10 @@ DEBS=(
   libstd-msgs-dev libgeometry-msgs-dev libsensor-msgs-dev libtrajectory-msgs-dev
   ros-std-msgs ros-geometry-msgs ros-sensor-msgs ros-trajectory-msgs
   python3-trajectory-msgs
+  # view.launch, plot_run, make pictures and the headless picture suites (view_rviz): Debian's rviz 1.14, the
+  # world's markers, bags, matplotlib (Agg); Xvfb + Mesa's software OpenGL, xwininfo/xdpyinfo, ImageMagick's import
+  rviz python3-visualization-msgs python3-rosbag python3-matplotlib
+  xvfb libgl1-mesa-dri x11-utils imagemagick
 )
 
 log() { printf '[setup] %s\n' "$*"; }
@@ -83,7 +87,7 @@ fi
 # the root itself would be a loop that roslib and rosrun walk into (each file found many times).
 PKG_LINK="$WS/src/diffbot_sim"
 mkdir -p "$PKG_LINK"
-for entry in package.xml CMakeLists.txt setup.py cmake src scripts launch urdf config tests worlds; do
+for entry in package.xml CMakeLists.txt setup.py cmake src scripts launch urdf config tests worlds rviz; do
   if [ ! -L "$PKG_LINK/$entry" ]; then
     ln -sfn "../../../$entry" "$PKG_LINK/$entry"
   fi

@@ -9,7 +9,6 @@ collision geometry is what the robot and its sensors meet, so it is what a user 
 Left out, each for a reason: planes (infinite; rviz's grid already shows the ground), dynamic bodies (they
 move when pushed, and a marker drawn at their start pose would show a box where there is none).
 """
-import math
 from dataclasses import dataclass, field
 from typing import Optional, Tuple
 
@@ -107,24 +106,26 @@ def _trimesh_specs(shape, pose, color, ns, budget, warnings):
 
 def bounds_xy(specs):
     """The x, y extent of ``specs`` in the world frame, ``(xmin, ymin, xmax, ymax)`` m, or None when there
-    are none: what the rviz view is fitted to. A shape counts by the circle around its footprint (never
-    smaller than the shape however it is turned); a triangle list by the corners of its points' box; a mesh,
-    whose size is unknown here, by its origin."""
+    are none: what the rviz view is fitted to. A shape counts by the corners of its bounding box as posed
+    (a cylinder's or sphere's box holds it); a triangle list by the corners of its points' box; a mesh, whose
+    size is unknown here, by its origin."""
     xs, ys = [], []
     for spec in specs:
-        (x, y, _), _ = spec.pose
         if spec.kind == TRIANGLE_LIST:
-            if len(spec.points):
-                lo, hi = np.min(spec.points, axis=0), np.max(spec.points, axis=0)
-                for cx in (lo[0], hi[0]):
-                    for cy in (lo[1], hi[1]):
-                        (px, py, _), _ = compose(spec.pose, ((float(cx), float(cy), 0.0), (0.0, 0.0, 0.0, 1.0)))
-                        xs.append(px)
-                        ys.append(py)
-            continue
-        r = 0.0 if spec.kind == MESH_RESOURCE else 0.5 * math.hypot(spec.scale[0], spec.scale[1])
-        xs += [x - r, x + r]
-        ys += [y - r, y + r]
+            if not len(spec.points):
+                continue
+            lo, hi = np.min(spec.points, axis=0), np.max(spec.points, axis=0)
+        elif spec.kind == MESH_RESOURCE:
+            lo = hi = np.zeros(3)
+        else:
+            hi = 0.5 * np.asarray(spec.scale, dtype=float)
+            lo = -hi
+        for cx in (lo[0], hi[0]):
+            for cy in (lo[1], hi[1]):
+                for cz in (lo[2], hi[2]):
+                    (px, py, _), _ = compose(spec.pose, ((float(cx), float(cy), float(cz)), (0.0, 0.0, 0.0, 1.0)))
+                    xs.append(px)
+                    ys.append(py)
     if not xs:
         return None
     return (min(xs), min(ys), max(xs), max(ys))

@@ -1,0 +1,291 @@
+"""Headless pictures: an Xvfb server, its windows, screenshots, and what is in them (no rospy).
+
+The rviz and PyBullet checks look at real windows on a real X server: Xvfb (a virtual screen, Mesa's
+llvmpipe renders the OpenGL), ``xwininfo`` (x11-utils) for the window tree, ImageMagick's ``import`` for
+the pixels. The picture analysis at the bottom is plain numpy on RGB arrays, unit-tested with made-up ones.
+
+What a window tree says about rviz (measured on rviz 1.14 under Xvfb): each Ogre render panel (the 3-D view,
+each Image display) is a window with no name inside the rviz window; every Qt widget is named ``rviz``.
+"""
+import os
+import re
+import shutil
+import subprocess
+import time
+from dataclasses import dataclass
+from typing import List
+
+import numpy as np
+
+SCREEN = (1280, 800)
+#: rviz's text colours in the Displays panel (rviz/properties/status_property.cpp, display.cpp): a display
+#: whose status is Ok is written in blue, Warn in orange, Error in red.
+STATUS_OK, STATUS_WARN, STATUS_ERROR = (40, 120, 197), (192, 128, 0), (192, 32, 32)
+
+
+class XvfbUnavailable(Exception):
+    """Xvfb is not installed or did not start: the headless picture checks cannot run here."""
+
+
+class Xvfb:
+    """An Xvfb server on a display number it picks itself (``-displayfd``: no race with another one).
+
+    Use as a context manager; ``display`` is ``":N"``. Stopped (SIGTERM, then SIGKILL) on exit.
+    """
+
+    def __init__(self, size=SCREEN, timeout=15.0):
+        self.size, self.timeout = size, timeout
+        self.proc, self.display = None, None
+
+    def __enter__(self):
+        if shutil.which("Xvfb") is None:
+            raise XvfbUnavailable("Xvfb is not installed (Debian package xvfb; make setup installs it)")
+        read_fd, write_fd = os.pipe()
+        try:
+            self.proc = subprocess.Popen(
+                ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", f"{self.size[0]}x{self.size[1]}x24",
+                 "-nolisten", "tcp", "-noreset"],
+                pass_fds=(write_fd,), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+        finally:
+            os.close(write_fd)
+        number = b""
+        deadline = time.monotonic() + self.timeout
+        with os.fdopen(read_fd, "rb") as pipe:
+            os.set_blocking(pipe.fileno(), False)
+            while not number.endswith(b"\n"):
+                if self.proc.poll() is not None:
+                    err = self.proc.stderr.read().decode(errors="replace").strip().splitlines()
+                    raise XvfbUnavailable(f"Xvfb exited {self.proc.returncode}: {err[-1] if err else ''}")
+                if time.monotonic() > deadline:
+                    self.stop()
+                    raise XvfbUnavailable(f"Xvfb gave no display number within {self.timeout:g} s")
+                chunk = pipe.read()
+                if chunk:
+                    number += chunk
+                else:
+                    time.sleep(0.02)
+        self.display = ":" + number.decode().strip()
+        wait_for(lambda: _xdpyinfo_ok(self.display), self.timeout, f"Xvfb {self.display} to answer")
+        return self
+
+    def stop(self):
+        if self.proc is not None and self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(5)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait(5)
+
+    def __exit__(self, *exc):
+        self.stop()
+        return False
+
+    def env(self, base=None):
+        """``base`` (default os.environ) with DISPLAY set to this server."""
+        env = dict(os.environ if base is None else base)
+        env["DISPLAY"] = self.display
+        return env
+
+
+def _xdpyinfo_ok(display):
+    try:
+        return subprocess.run(["xdpyinfo", "-display", display], stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL, timeout=5).returncode == 0
+    except (OSError, subprocess.TimeoutExpired):
+        return False
+
+
+def wait_for(predicate, timeout, what, period=0.1):
+    """Poll ``predicate`` until it returns something true; AssertionError naming ``what`` after
+    ``timeout`` wall seconds."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = predicate()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout:g} s waiting for {what}")
+        time.sleep(period)
+
+
+@dataclass
+class Window:
+    """One X window: id, name ('' when it has none), size and absolute position (pixels), tree depth."""
+
+    wid: str
+    name: str
+    width: int
+    height: int
+    x: int
+    y: int
+    depth: int
+    children: int = 0
+
+    @property
+    def area(self):
+        return self.width * self.height
+
+    def box(self):
+        """``(x0, y0, x1, y1)``: its pixels on the screen, x1/y1 exclusive."""
+        return self.x, self.y, self.x + self.width, self.y + self.height
+
+
+_LINE = re.compile(r'^(?P<indent>\s*)(?P<wid>0x[0-9a-f]+) (?:"(?P<name>.*?)":|\(has no name\)).*?'
+                   r'(?P<w>\d+)x(?P<h>\d+)[+-]-?\d+[+-]-?\d+\s+\+(?P<ax>-?\d+)\+(?P<ay>-?\d+)\s*$')
+
+
+def parse_tree(text):
+    """The windows ``xwininfo -root -tree`` lists, in its order, with their depth (by indentation)."""
+    windows = []
+    for line in text.splitlines():
+        m = _LINE.match(line)
+        if not m:
+            continue
+        windows.append(Window(m["wid"], m["name"] or "", int(m["w"]), int(m["h"]), int(m["ax"]), int(m["ay"]),
+                              len(m["indent"]) // 3))
+    for i, window in enumerate(windows):
+        j = i + 1
+        while j < len(windows) and windows[j].depth > window.depth:
+            j += 1
+        window.children = j - i - 1
+    return windows
+
+
+def subtree(windows, top):
+    """The windows below ``top`` (a Window of ``windows``), ``top`` excluded."""
+    i = windows.index(top)
+    return windows[i + 1:i + 1 + top.children]
+
+
+def list_windows(display):
+    """Every window on ``display`` (``xwininfo -root -tree``)."""
+    out = subprocess.run(["xwininfo", "-root", "-tree", "-display", display], capture_output=True, text=True,
+                         timeout=10)
+    return parse_tree(out.stdout) if out.returncode == 0 else []
+
+
+def find_window(display, pattern):
+    """The first top-level-ish window whose name matches ``pattern`` (a regex) and has a real size, or None."""
+    rx = re.compile(pattern)
+    for window in list_windows(display):
+        if rx.search(window.name) and window.width > 100 and window.height > 100:
+            return window
+    return None
+
+
+def screenshot(display, window="root"):
+    """The screen (or one window, by id) as an (H, W, 3) uint8 RGB array, through ImageMagick's import."""
+    from PIL import Image
+    import io
+
+    out = subprocess.run(["import", "-display", display, "-window", window, "png:-"], capture_output=True,
+                         timeout=30)
+    if out.returncode != 0:
+        raise AssertionError(f"import -window {window} failed: {out.stderr.decode(errors='replace').strip()}")
+    return np.asarray(Image.open(io.BytesIO(out.stdout)).convert("RGB"))
+
+
+def save_png(image, path, max_width=None, exact=False):
+    """Write an RGB array as PNG, scaled down to ``max_width`` pixels when wider; palette-reduced to 128
+    colours (screenshots stay small) unless ``exact``."""
+    from PIL import Image
+
+    picture = Image.fromarray(np.asarray(image, dtype=np.uint8))
+    if max_width and picture.width > max_width:
+        picture = picture.resize((max_width, round(picture.height * max_width / picture.width)), Image.LANCZOS)
+    if not exact:
+        picture = picture.quantize(colors=128, method=Image.MEDIANCUT, dither=Image.NONE)
+    picture.save(path, optimize=True)
+
+
+# ------------------------------------------------------------------------------------------ analysis
+
+def crop(image, box):
+    """The pixels of ``box`` (x0, y0, x1, y1) of ``image``, clipped to it."""
+    x0, y0, x1, y1 = box
+    h, w = image.shape[:2]
+    return image[max(0, y0):min(h, y1), max(0, x0):min(w, x1)]
+
+
+def count_color(image, rgb, mask=None):
+    """How many pixels of ``image`` are exactly ``rgb`` (where ``mask`` is true, when given)."""
+    hit = np.all(image == np.asarray(rgb, dtype=image.dtype), axis=2)
+    if mask is not None:
+        hit &= mask
+    return int(hit.sum())
+
+
+def status_colors(image, mask=None):
+    """``{"ok": n, "warn": n, "error": n}``: pixels in rviz's status text colours (see STATUS_*)."""
+    return {name: count_color(image, rgb, mask)
+            for name, rgb in (("ok", STATUS_OK), ("warn", STATUS_WARN), ("error", STATUS_ERROR))}
+
+
+def rows_of_color(image, rgb):
+    """The row numbers (y) that hold ``rgb`` pixels: where a warning or error sits in the Displays list."""
+    return sorted(set(np.nonzero(np.all(image == np.asarray(rgb, dtype=image.dtype), axis=2))[0].tolist()))
+
+
+def changed(a, b, threshold=40):
+    """Boolean mask of pixels whose RGB differ by more than ``threshold`` (sum of absolute differences)."""
+    return np.abs(a.astype(int) - b.astype(int)).sum(axis=2) > threshold
+
+
+def blob(mask):
+    """``(count, (u, v) centroid, (u0, v0, u1, v1) bounding box)`` of the true pixels of ``mask``, or
+    ``(0, None, None)`` when there are none. u is the column (x), v the row (y)."""
+    vs, us = np.nonzero(mask)
+    if len(us) == 0:
+        return 0, None, None
+    return len(us), (float(us.mean()), float(vs.mean())), (int(us.min()), int(vs.min()), int(us.max()),
+                                                           int(vs.max()))
+
+
+def patch(mask, radius):
+    """The main patch of true pixels of ``mask``, robust to stray ones elsewhere: centred on the median
+    pixel, the pixels within ``radius`` of it. Returns ``(count, (u, v) centroid, stray)``, ``stray``
+    counting the true pixels outside; ``(0, None, 0)`` when there are none."""
+    vs, us = np.nonzero(mask)
+    if len(us) == 0:
+        return 0, None, 0
+    mu, mv = float(np.median(us)), float(np.median(vs))
+    near = (us - mu) ** 2 + (vs - mv) ** 2 <= radius ** 2
+    return int(near.sum()), (float(us[near].mean()), float(vs[near].mean())), int((~near).sum())
+
+
+def greenish(image, margin=40):
+    """Pixels whose green exceeds both red and blue by ``margin``: laser points, also where they blend into
+    what is next to them."""
+    img = image.astype(int)
+    return (img[:, :, 1] - np.maximum(img[:, :, 0], img[:, :, 2])) > margin
+
+
+def top_view_pixel(x, y, panel, center, scale):
+    """Where rviz's TopDownOrtho view (angle 0) draws the point ``(x, y)`` m of the fixed frame.
+
+    Args:
+        panel: the 3-D view's Window (or ``(x0, y0, x1, y1)``) on the screen.
+        center: the view's ``(X, Y)`` m (its centre).
+        scale: its ``Scale``, pixels per metre.
+
+    Returns:
+        (u, v) screen pixel: +x to the right, +y up.
+    """
+    x0, y0, x1, y1 = panel.box() if isinstance(panel, Window) else panel
+    return (x0 + (x1 - x0) / 2.0 + scale * (x - center[0]), y0 + (y1 - y0) / 2.0 - scale * (y - center[1]))
+
+
+def project(point, view, projection, size):
+    """Where an OpenGL camera (column-major 4x4 ``view`` and ``projection``, as PyBullet gives them) draws
+    the world ``point`` in a window of ``size`` (width, height): (u, v) pixels, v down."""
+    v = np.asarray(view, dtype=float).reshape(4, 4).T
+    p = np.asarray(projection, dtype=float).reshape(4, 4).T
+    clip = p @ v @ np.array([point[0], point[1], point[2], 1.0])
+    ndc = clip[:3] / clip[3]
+    return ((ndc[0] + 1.0) / 2.0 * size[0], (1.0 - ndc[1]) / 2.0 * size[1])
+
+
+__all__: List[str] = ["Xvfb", "XvfbUnavailable", "Window", "parse_tree", "subtree", "list_windows", "find_window",
+                      "screenshot", "save_png", "crop", "count_color", "status_colors", "rows_of_color",
+                      "changed", "blob", "patch", "greenish", "top_view_pixel", "project", "wait_for"]

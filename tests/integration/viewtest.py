@@ -1,0 +1,244 @@
+"""Shared helpers of the headless picture suites (view_rviz, view_gui): an Xvfb server, ``view.launch``
+started against the rostest master as a user would start it, screenshots, and rviz's own services.
+
+Callbacks only record; the test thread asserts. Waits poll with deadlines (xscreen.wait_for).
+"""
+import os
+import signal
+import struct
+import subprocess
+import threading
+import time
+import xmlrpc.client
+
+import genpy
+import rosgraph
+import rospy
+import yaml
+from geometry_msgs.msg import Twist
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Log
+
+from diffbot_sim import xscreen
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
+ROBOT = os.path.join(ROOT, "tests", "data", "robots", "view_robot.urdf")
+WORLD = os.path.join(ROOT, "tests", "data", "worlds", "laser_room.world")
+
+
+class _SendFilePathRequest(genpy.Message):
+    """rviz/SendFilePath's request (``std_msgs/String path``: on the wire, one string), written by hand:
+    Debian's rviz ships no Python module for its services. roscpp's service server accepts md5sum ``*``."""
+
+    _type, _md5sum, _has_header, _full_text = "rviz/SendFilePathRequest", "*", False, "std_msgs/String path"
+    __slots__ = ["path"]
+    _slot_types = ["string"]
+
+    def __init__(self, path=""):
+        super().__init__()
+        self.path = path
+
+    def serialize(self, buff):
+        data = self.path.encode()
+        buff.write(struct.pack("<I", len(data)) + data)
+
+
+class _SendFilePathResponse(genpy.Message):
+    _type, _md5sum, _has_header, _full_text = "rviz/SendFilePathResponse", "*", False, "bool success"
+    __slots__ = ["success"]
+    _slot_types = ["bool"]
+
+    def __init__(self):
+        super().__init__()
+        self.success = False
+
+    def deserialize(self, data):
+        self.success = bool(data[0]) if data else False
+        return self
+
+
+class SendFilePath:
+    _type, _md5sum = "rviz/SendFilePath", "*"
+    _request_class, _response_class = _SendFilePathRequest, _SendFilePathResponse
+
+
+class View:
+    """``roslaunch diffbot_sim view.launch ARGS`` on a fresh Xvfb, on the rostest master.
+
+    ``start()`` raises xscreen.XvfbUnavailable when no X server can be had (the only reason to skip).
+    """
+
+    def __init__(self, args, log_name):
+        self.args, self.log_name = list(args), log_name
+        self.xvfb = None
+        self.proc = None
+        self.lock = threading.Lock()
+        self.logs = []
+        self.odom = []
+        home = os.environ.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
+        self.home = home
+        self.log_path = os.path.join(home, log_name + ".log")
+
+    # -------------------------------------------------------------------------------------- lifecycle
+
+    def start(self):
+        rospy.on_shutdown(self.stop)  # rostest ends a test node by signal: leave no X server or rviz behind
+        self.xvfb = xscreen.Xvfb().__enter__()
+        self.log_sub = rospy.Subscriber("/rosout_agg", Log, self._keep, callback_args=self.logs, queue_size=1000)
+        self.odom_sub = rospy.Subscriber("/odom", Odometry, self._keep, callback_args=self.odom, queue_size=100)
+        self.cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
+        os.makedirs(self.home, exist_ok=True)
+        self.log_file = open(self.log_path, "w")
+        self.proc = subprocess.Popen(["roslaunch", "diffbot_sim", "view.launch"] + self.args,
+                                     env=self.xvfb.env(), stdout=self.log_file, stderr=subprocess.STDOUT,
+                                     stdin=subprocess.DEVNULL, start_new_session=True)
+        return self
+
+    def stop(self):
+        if self.proc is not None and self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGINT)
+            try:
+                self.proc.wait(20)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+                self.proc.wait(5)
+        if self.xvfb is not None:
+            self.xvfb.stop()
+
+    def _keep(self, msg, store):
+        with self.lock:
+            store.append(msg)
+
+    def alive(self):
+        """Fail when roslaunch ended: a required node (bullet_sim, rviz) died."""
+        if self.proc.poll() is not None:
+            raise AssertionError(f"roslaunch view.launch exited {self.proc.returncode} (see {self.log_path}):\n"
+                                 + self.tail())
+
+    def tail(self, lines=15):
+        self.log_file.flush()
+        with open(self.log_path, errors="replace") as f:
+            return "".join(f.readlines()[-lines:])
+
+    def wait(self, predicate, timeout, what):
+        """Poll ``predicate`` (failing at once when roslaunch ends) until true, within ``timeout`` s."""
+        def check():
+            self.alive()
+            return predicate()
+        return xscreen.wait_for(check, timeout, what)
+
+    # ---------------------------------------------------------------------------------------- ROS side
+
+    def last_odom(self):
+        with self.lock:
+            return self.odom[-1] if self.odom else None
+
+    def errors_from(self, node, level=Log.WARN):
+        """rosout messages of ``node`` at ``level`` or worse, as ``"LEVEL: text"`` lines."""
+        names = {Log.DEBUG: "DEBUG", Log.INFO: "INFO", Log.WARN: "WARN", Log.ERROR: "ERROR", Log.FATAL: "FATAL"}
+        with self.lock:
+            return [f"{names.get(m.level, m.level)}: {m.msg}" for m in self.logs if m.name == node and
+                    m.level >= level]
+
+    def node_uri(self, node):
+        try:
+            return rosgraph.Master("/test_view").lookupNode(node)
+        except Exception:
+            return None
+
+    def subscriptions(self, node):
+        """Topics ``node`` subscribes, from the master."""
+        _, subs, _ = rosgraph.Master("/test_view").getSystemState()
+        return sorted(topic for topic, nodes in subs if node in nodes)
+
+    def received(self, node):
+        """``{topic: messages received}`` of ``node``, from its own bus statistics (roscpp's
+        getBusStats slave call, which answers [publish stats, subscribe stats] without the usual status
+        code; per connection [id, bytes, messages, drops, connected])."""
+        uri = self.node_uri(node)
+        if uri is None:
+            return {}
+        stats = with_timeout(lambda: xmlrpc.client.ServerProxy(uri).getBusStats("/test_view"), 10.0,
+                             f"{node}'s getBusStats")
+        counts = {}
+        for topic, connections in stats[1]:
+            counts[topic] = counts.get(topic, 0) + sum(c[2] for c in connections)
+        return counts
+
+    def load_config(self, path, timeout=20.0):
+        """Make rviz open ``path``: every display is rebuilt from it. The ``_discarding_changes`` service,
+        because plain ``~load_config`` first asks, in a dialog, whether to save the changed config, and
+        waits for an answer nobody gives under Xvfb (seen: the call never returned)."""
+        service = "/rviz/load_config_discarding_changes"
+        rospy.wait_for_service(service, timeout)
+        proxy = rospy.ServiceProxy(service, SendFilePath)
+        response = with_timeout(lambda: proxy(path), timeout, f"rviz's {service} {path}")
+        assert response.success, f"rviz could not load {path}"
+
+    def drive(self, linear, angular, seconds):
+        """Publish a Twist at 20 Hz for ``seconds`` of sim time, then a zero one."""
+        start = rospy.get_time()
+        while rospy.get_time() - start < seconds:
+            self.alive()
+            twist = Twist()
+            twist.linear.x, twist.angular.z = linear, angular
+            self.cmd.publish(twist)
+            time.sleep(0.05)
+        self.cmd.publish(Twist())
+
+    # -------------------------------------------------------------------------------------- X side
+
+    def windows(self):
+        return xscreen.list_windows(self.xvfb.display)
+
+    def screenshot(self):
+        return xscreen.screenshot(self.xvfb.display)
+
+
+def with_timeout(call, timeout, what):
+    """``call()`` in a thread; AssertionError naming ``what`` when it has not returned within ``timeout`` s
+    (a service call or XML-RPC request to a hung rviz would otherwise block the test for ever)."""
+    box = {}
+
+    def run():
+        try:
+            box["value"] = call()
+        except BaseException as err:  # handed to the test thread below
+            box["error"] = err
+    thread = threading.Thread(target=run, daemon=True)
+    thread.start()
+    thread.join(timeout)
+    if thread.is_alive():
+        raise AssertionError(f"no answer from {what} within {timeout:g} s")
+    if "error" in box:
+        raise box["error"]
+    return box["value"]
+
+
+def save_frame(image, name):
+    """Keep a screenshot next to the suite's logs (ROS_HOME), for whoever reads a failure."""
+    home = os.environ.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
+    xscreen.save_png(image, os.path.join(home, name + ".png"), exact=True)
+
+
+def generated_config():
+    """The config view_rviz wrote for this run (ROS_HOME/diffbot_sim/view.rviz), as a dict."""
+    home = os.environ.get("ROS_HOME") or os.path.join(os.path.expanduser("~"), ".ros")
+    with open(os.path.join(home, "diffbot_sim", "view.rviz")) as f:
+        return yaml.safe_load(f)
+
+
+def config_variant(config, path, **enabled):
+    """Write ``config`` to ``path`` with the displays named in ``enabled`` switched on or off
+    (``RobotModel=False``; a name may start a display's name: ``LaserScan`` matches ``LaserScan /scan``)."""
+    import copy
+
+    variant = copy.deepcopy(config)
+    for display in variant["Visualization Manager"]["Displays"]:
+        for name, on in enabled.items():
+            if display.get("Name", "").startswith(name):
+                display["Enabled"] = on
+                display["Value"] = on
+    with open(path, "w") as f:
+        yaml.safe_dump(variant, f, sort_keys=False)
+    return path

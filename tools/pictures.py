@@ -1,0 +1,201 @@
+#!/usr/bin/env python3
+"""``make pictures``: the README's pictures from a scripted run, under Xvfb (docs/*.png).
+
+1. ``view.launch`` (tests/data/robots/view_robot.urdf: laser + camera, in worlds/room.world, ground truth
+   on), started three times: each time, wall seconds from ``roslaunch`` to the first rviz frame showing the
+   robot (its yellow top in the 3-D view). The median goes to the README's Speed section.
+2. The last of those runs drives a scripted path (forward, turn, forward, arc) while this process records
+   odometry, ground truth, commands, the scan and TF; then ``docs/rviz.png`` (the rviz window) and
+   ``docs/run.png`` (``plot_run``'s picture of the recording).
+3. ``view.launch gui:=true rviz:=false`` drives a little and ``docs/pybullet.png`` is PyBullet's window.
+
+Every process is started in its own session and stopped by its process group; each run has its own master
+(``roslaunch -p PORT``). Prints one line per step, so a reader knows it is alive (about 1 min in all).
+"""
+import os
+import signal
+import socket
+import statistics
+import subprocess
+import sys
+import threading
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "src"))
+
+from diffbot_sim import xscreen  # noqa: E402
+
+DOCS = os.path.join(ROOT, "docs")
+ROBOT = os.path.join(ROOT, "tests", "data", "robots", "view_robot.urdf")
+WORLD = os.path.join(ROOT, "worlds", "room.world")
+RUNS = 3
+YELLOW_PIXELS = 100  # the robot's top (0.26 x 0.18 m) covers ~500 pixels in the fitted top view
+MAX_WIDTH = 960  # px: pictures are scaled to this width (and palette-reduced) to stay under 200 KB
+
+
+def say(text):
+    print(f"[pictures] {text}", flush=True)
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Launch:
+    """``roslaunch -p PORT diffbot_sim view.launch ARGS`` on ``display``, in its own session."""
+
+    def __init__(self, display, args, log):
+        self.port = free_port()
+        self.env = dict(os.environ, DISPLAY=display, ROS_MASTER_URI=f"http://localhost:{self.port}")
+        self.log = open(log, "w")
+        self.started = time.monotonic()
+        self.proc = subprocess.Popen(["roslaunch", "-p", str(self.port), "diffbot_sim", "view.launch"] + args,
+                                     env=self.env, stdout=self.log, stderr=subprocess.STDOUT,
+                                     stdin=subprocess.DEVNULL, start_new_session=True)
+
+    def check(self):
+        if self.proc.poll() is not None:
+            raise SystemExit(f"[pictures] roslaunch exited {self.proc.returncode}; see {self.log.name}")
+
+    def stop(self):
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGINT)
+            try:
+                self.proc.wait(20)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+                self.proc.wait(5)
+        self.log.close()
+
+
+def rviz_view(display):
+    """(rviz window, its 3-D view panel) once rviz has its configured size, else None."""
+    windows = xscreen.list_windows(display)
+    for top in windows:
+        if top.name.endswith("RViz") and (top.width, top.height) == xscreen.SCREEN:
+            panels = [w for w in xscreen.subtree(windows, top) if not w.name]
+            if panels:
+                return top, max(panels, key=lambda w: w.area)
+    return None
+
+
+def robot_drawn(display):
+    """True once the 3-D view shows the robot's yellow top."""
+    found = rviz_view(display)
+    if found is None:
+        return False
+    frame = xscreen.crop(xscreen.screenshot(display), found[1].box()).astype(int)
+    yellow = (frame[:, :, 0] > 200) & (frame[:, :, 1] > 150) & (frame[:, :, 2] < 80)
+    return int(yellow.sum()) >= YELLOW_PIXELS
+
+
+def first_frame(display, args, log):
+    launch = Launch(display, args, log)
+
+    def ready():
+        launch.check()
+        return robot_drawn(display)
+    xscreen.wait_for(ready, 120, "the first rviz frame with the robot", period=0.05)
+    return launch, time.monotonic() - launch.started
+
+
+class Recorder:
+    """This process as a ROS node: records what plot_run reads and drives the robot."""
+
+    def __init__(self, env):
+        os.environ["ROS_MASTER_URI"] = env["ROS_MASTER_URI"]
+        import rospy
+        from geometry_msgs.msg import Twist
+        from nav_msgs.msg import Odometry
+        from sensor_msgs.msg import LaserScan
+        from tf2_msgs.msg import TFMessage
+
+        self.rospy, self.Twist = rospy, Twist
+        rospy.init_node("pictures", anonymous=True, disable_signals=True)
+        self.records, self.lock = [], threading.Lock()
+        self.subs = [rospy.Subscriber(t, k, self._keep, callback_args=t, queue_size=1000) for t, k in (
+            ("/odom", Odometry), ("/bullet_sim/ground_truth", Odometry), ("/cmd_vel", Twist),
+            ("/scan", LaserScan), ("/tf", TFMessage), ("/tf_static", TFMessage))]
+        self.cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
+
+    def _keep(self, msg, topic):
+        with self.lock:
+            self.records.append((topic, msg, self.rospy.get_time()))
+
+    def drive(self, plan):
+        """``plan``: [(linear m/s, angular rad/s, sim seconds)], then a stop."""
+        rospy = self.rospy
+        xscreen.wait_for(lambda: self.cmd.get_num_connections() > 0, 20, "the simulator to subscribe /cmd_vel")
+        for linear, angular, seconds in plan:
+            start = rospy.get_time()
+            while rospy.get_time() - start < seconds:
+                twist = self.Twist()
+                twist.linear.x, twist.angular.z = linear, angular
+                self.cmd.publish(twist)
+                time.sleep(0.05)
+        self.cmd.publish(self.Twist())
+        time.sleep(1.0)  # let the stop show in the recording and in rviz (1 s of real time at RTF 1)
+
+    def take(self):
+        with self.lock:
+            return list(self.records)
+
+
+def main():
+    from diffbot_sim import plot_data
+    from diffbot_sim.nodes import plot_run
+
+    os.makedirs(DOCS, exist_ok=True)
+    logs = os.path.join(ROOT, "test-results", "pictures")
+    os.makedirs(logs, exist_ok=True)
+    args = [f"model:={ROBOT}", f"world:={WORLD}", "publish_ground_truth:=true"]
+    times = []
+    with xscreen.Xvfb() as x:
+        say(f"Xvfb on {x.display}; {RUNS} starts of view.launch, timing roslaunch -> first rviz frame with the robot")
+        launch = None
+        for i in range(RUNS):
+            launch, seconds = first_frame(x.display, args, os.path.join(logs, f"view{i}.log"))
+            times.append(seconds)
+            say(f"run {i + 1}: first frame with the robot after {seconds:.2f} s")
+            if i < RUNS - 1:
+                launch.stop()
+        try:
+            say("driving the scripted path (about 15 s)")
+            recorder = Recorder(launch.env)
+            xscreen.wait_for(lambda: recorder.subs[0].get_num_connections() > 0, 20, "/odom to connect")
+            recorder.drive([(0.4, 0.0, 3.0), (0.0, 0.8, 2.0), (0.3, 0.0, 2.5), (0.3, -0.6, 4.0)])
+            top, _ = rviz_view(x.display)
+            xscreen.save_png(xscreen.crop(xscreen.screenshot(x.display), top.box()), os.path.join(DOCS, "rviz.png"),
+                             MAX_WIDTH)
+            data = plot_data.collect(recorder.take())
+            drawn = plot_run.plot(data, os.path.join(DOCS, "run.png"), "make pictures")
+            say(f"docs/rviz.png, docs/run.png ({drawn['summary'].distance:.2f} m driven)")
+        finally:
+            launch.stop()
+        say("PyBullet's window: view.launch gui:=true rviz:=false")
+        gui = Launch(x.display, args + ["gui:=true", "rviz:=false"], os.path.join(logs, "gui.log"))
+        try:
+            window = xscreen.wait_for(lambda: gui.check() or xscreen.find_window(x.display, "Bullet Physics"),
+                                      60, "PyBullet's window")
+            # PyBullet's first frames are a flat background: wait until the window shows the scene.
+            xscreen.wait_for(lambda: xscreen.crop(xscreen.screenshot(x.display), window.box()).std() > 20, 60,
+                             "PyBullet to draw the scene")
+            xscreen.save_png(xscreen.crop(xscreen.screenshot(x.display), window.box()),
+                             os.path.join(DOCS, "pybullet.png"), MAX_WIDTH)
+            say("docs/pybullet.png")
+        finally:
+            gui.stop()
+    median = statistics.median(times)
+    say(f"roslaunch -> first rviz frame with the robot, under Xvfb: median {median:.2f} s of {RUNS} "
+        f"({', '.join(f'{t:.2f}' for t in times)})")
+    for name in ("rviz.png", "run.png", "pybullet.png"):
+        size = os.path.getsize(os.path.join(DOCS, name))
+        say(f"docs/{name}: {size // 1024} KB" + (" (over 200 KB!)" if size > 200 * 1024 else ""))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
