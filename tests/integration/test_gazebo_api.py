@@ -23,6 +23,7 @@ from gazebo_msgs import msg as gmsg
 from gazebo_msgs import srv as gsrv
 from geometry_msgs.msg import Point, Pose, Quaternion, Twist, Wrench, Vector3
 from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty
 
 GZ = "/gazebo"
@@ -275,8 +276,11 @@ class GazeboApiTest(unittest.TestCase):
         rospy.ServiceProxy(f"{GZ}/pause_physics", Empty)()
         self.assertTrue(proxy("get_physics_properties", gsrv.GetPhysicsProperties)().pause)
         t0 = self.world().sim_time
-        time.sleep(0.3)  # observing that time stands: a bounded look
+        clock = Latest("/clock", Clock)  # Gazebo keeps publishing /clock while paused (spawners wait for one)
+        wait(lambda: clock.count >= 3, 10.0, "/clock while paused")
+        self.assertAlmostEqual(clock.get().clock.to_sec(), t0, delta=1e-6)
         self.assertEqual(self.world().sim_time, t0)
+        clock.sub.unregister()
         rospy.ServiceProxy(f"{GZ}/unpause_physics", Empty)()
         wait(lambda: self.world().sim_time > t0 + 0.1, 10.0, "sim time after unpause")
         # reset_world: models back to where they started; time goes on

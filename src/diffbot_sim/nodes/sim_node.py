@@ -321,6 +321,9 @@ class Simulator:
         while not rospy.is_shutdown():
             self._handle_requests()
             if self.paused:
+                # Gazebo keeps publishing /clock while paused: nodes that wait for a first /clock (the
+                # controller spawner, rospy.sleep) must not hang on a world started paused.
+                self._publish_clock(self.sim_time)
                 self.links.release()
                 self.wake.wait(0.1)
                 self.wake.clear()

@@ -255,6 +255,8 @@ class RosControl(Plugin):
         out = []
         for name, runner in self.loaded.items():
             claimed = {}
+            if runner.type == JSC_TYPE:  # it reads every joint and claims none, as controller_manager lists it
+                claimed["JointStateInterface"] = []
             for joint in sorted(runner.joints()):
                 claimed.setdefault(self.interfaces.get(joint, ""), []).append(joint)
             out.append((name, "running" if runner in self.controllers else "stopped", runner.type, claimed))
