@@ -376,12 +376,12 @@ class World:
             robot.gravity = gravity
 
     def reset(self):
-        """Put every robot back at its spawn pose and every dynamic world body at its start, at rest."""
+        """Put every robot back at its spawn pose and every world body at its start (a static one too: the
+        world API may have moved it), at rest."""
         for robot in self.robots:
             robot.reset()
         for uid, body in self.world_bodies:
-            if not body.static:
-                self._place(uid, body.pose, body.inertial_pose)
+            self._place(uid, body.pose, body.inertial_pose)
 
     def close(self):
         if self.client is not None and pybullet.isConnected(self.client):

@@ -278,14 +278,95 @@ def top_view_pixel(x, y, panel, center, scale):
 
 def project(point, view, projection, size):
     """Where an OpenGL camera (column-major 4x4 ``view`` and ``projection``, as PyBullet gives them) draws
-    the world ``point`` in a window of ``size`` (width, height): (u, v) pixels, v down."""
+    the world ``point`` in a window of ``size`` (width, height): (u, v) pixels, v down; None when the point
+    is behind the camera (dividing by a negative w would put it on the screen, mirrored)."""
     v = np.asarray(view, dtype=float).reshape(4, 4).T
     p = np.asarray(projection, dtype=float).reshape(4, 4).T
     clip = p @ v @ np.array([point[0], point[1], point[2], 1.0])
+    if clip[3] <= 0.0:
+        return None
     ndc = clip[:3] / clip[3]
     return ((ndc[0] + 1.0) / 2.0 * size[0], (1.0 - ndc[1]) / 2.0 * size[1])
 
 
+#: PyBullet's window as it opens (pybullet 3.2, getDebugVisualizerCamera measured under Xvfb): 1024 x 768,
+#: camera aimed at the world origin from 5 m, yaw 50 deg, pitch -35 deg, z up; its 3-D view fills the window
+#: (the Explorer/Params/log panels are drawn over it).
+PYBULLET_WINDOW = (1024, 768)
+PYBULLET_CAMERA = {"target": (0.0, 0.0, 0.0), "distance": 5.0, "yaw": 50.0, "pitch": -35.0}
+#: The part of that window's 3-D view no panel covers (x0, y0, x1, y1; measured: the sky of an empty scene
+#: spans columns 254-773, rows 22-645).
+PYBULLET_SCENE_BOX = (254, 22, 774, 646)
+
+
+def orbit_camera(target, distance, yaw, pitch, size, near=0.01, far=1000.0):
+    """``(view, projection)`` of PyBullet's debug-window camera (column-major 16-tuples, as
+    ``getDebugVisualizerCamera`` returns them; for :func:`project`), z up.
+
+    PyBullet's SimpleCamera: at yaw 0 and pitch 0 the eye is ``distance`` m on -y of ``target`` looking
+    along +y; yaw turns it about z (degrees, counter-clockwise seen from above), pitch below 0 raises the eye
+    (looking down). The frustum spans 90 deg vertically, ``width / height`` wider horizontally.
+    Checked against getDebugVisualizerCamera for the defaults (PYBULLET_CAMERA) to 1e-6."""
+    yaw_r, pitch_r = np.radians(yaw), np.radians(pitch)
+    forward = np.array([-np.sin(yaw_r) * np.cos(pitch_r), np.cos(yaw_r) * np.cos(pitch_r), np.sin(pitch_r)])
+    eye = np.asarray(target, dtype=float) - distance * forward
+    right = np.cross(forward, (0.0, 0.0, 1.0))
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    view = np.eye(4)
+    view[0, :3], view[1, :3], view[2, :3] = right, up, -forward
+    view[:3, 3] = -view[:3, :3] @ eye
+    aspect = size[0] / float(size[1])
+    projection = np.zeros((4, 4))
+    projection[0, 0], projection[1, 1] = 1.0 / aspect, 1.0
+    projection[2, 2], projection[2, 3] = -(far + near) / (far - near), -2.0 * far * near / (far - near)
+    projection[3, 2] = -1.0
+    return tuple(view.T.ravel()), tuple(projection.T.ravel())
+
+
+def pybullet_pixel(point, size=PYBULLET_WINDOW, camera=None):
+    """Where PyBullet's window (of ``size``, its default camera unless ``camera``, a PYBULLET_CAMERA-like
+    dict) draws the world ``point``: (u, v) pixels of the window, or None when behind the camera."""
+    cam = dict(PYBULLET_CAMERA, **(camera or {}))
+    view, projection = orbit_camera(cam["target"], cam["distance"], cam["yaw"], cam["pitch"], size)
+    return project(point, view, projection, size)
+
+
+#: Hue ranges (degrees, HSV) of :func:`saturated`'s classes. PyBullet's palette, whose colours it gives
+#: bodies that have none (examples/OpenGLWindow/GLInstancingRenderer / OpenGLGuiHelper ``sColors``): red
+#: (219, 50, 54) hue 359, yellow (244, 194, 13) 47, green (60, 186, 84) 131, blue (72, 133, 237) 218.
+HUES = {"red": (-20.0, 20.0), "yellow": (30.0, 70.0), "green": (90.0, 170.0), "blue": (190.0, 250.0)}
+
+
+def hue(image):
+    """HSV hue of every pixel of an RGB array, degrees in [-60, 300) (reds on both sides of 0)."""
+    img = image.astype(float)
+    r, g, b = img[:, :, 0], img[:, :, 1], img[:, :, 2]
+    hi, lo = img.max(axis=2), img.min(axis=2)
+    spread = np.where(hi > lo, hi - lo, 1.0)
+    return np.where(r == hi, 60.0 * (g - b) / spread,
+                    np.where(g == hi, 120.0 + 60.0 * (b - r) / spread, 240.0 + 60.0 * (r - g) / spread))
+
+
+def saturated(image, min_saturation=0.5, min_value=60):
+    """``{"red", "yellow", "green", "blue": mask}``: strongly coloured pixels by hue (HUES). Strong: the
+    brightest channel over ``min_value`` and the spread (brightest - darkest) over ``min_saturation`` of it
+    (HSV's V and S), so lit and shaded faces of one colour count alike. Grey, white and the pale blue-grey of
+    PyBullet's floor and sky (S about 0.3) are in no class."""
+    img = image.astype(int)
+    hi, lo = img.max(axis=2), img.min(axis=2)
+    strong = (hi > min_value) & (hi - lo > min_saturation * hi)
+    h = hue(image)
+    return {name: strong & (h >= low) & (h < high) for name, (low, high) in HUES.items()}
+
+
+def color_counts(image, **kw):
+    """``{"red": n, "yellow": n, "green": n, "blue": n}``: pixel counts of :func:`saturated`'s classes."""
+    return {name: int(mask.sum()) for name, mask in saturated(image, **kw).items()}
+
+
 __all__: List[str] = ["Xvfb", "XvfbUnavailable", "Window", "parse_tree", "subtree", "list_windows", "find_window",
                       "screenshot", "save_png", "crop", "count_color", "status_colors", "rows_of_color",
-                      "changed", "blob", "patch", "greenish", "top_view_pixel", "project", "wait_for"]
+                      "changed", "blob", "patch", "greenish", "top_view_pixel", "project", "orbit_camera",
+           "pybullet_pixel", "PYBULLET_CAMERA", "PYBULLET_WINDOW", "saturated", "color_counts", "hue", "HUES",
+           "PYBULLET_SCENE_BOX", "wait_for"]

@@ -130,9 +130,9 @@ def call(service):
 
 
 def reset_robot(rec):
-    """Zero the command, reset the simulation, and wait until odom shows the robot back at rest."""
+    """Zero the command, reset the world (models to their start; sim time goes on), and wait until odom shows the robot back at rest."""
     rec.send(0.0, 0.0)
-    call(SIM + "/reset_simulation")
+    call(SIM + "/reset_world")  # time goes on (reset_simulation would send it back to 0)
     after = rec.sim_time() + 0.1  # the service returned: anything stamped later follows the reset
 
     def at_rest():

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Soak (slow_soak.test): one simulated hour in fast mode (``real_time:=false``) while the robot drives a
-changing pattern and the simulation is reset every 10 sim minutes.
+changing pattern and the world is reset (reset_world: sim time goes on) every 10 sim minutes.
 
 Checked: bullet_sim's resident memory (VmRSS of the pid it reports over XML-RPC) grows by < 5 MB between the
 end of a 60 s warm-up and the end of the hour; odom stamps strictly increase; /clock never goes back (strictly
@@ -70,8 +70,8 @@ class SoakTest(unittest.TestCase):
         rospy.Subscriber("/rosout", Log, lambda m: rosout.append(m) if m.name == SIM and m.level >= Log.WARN
                          else None, queue_size=1000)
         cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=10)
-        rospy.wait_for_service(SIM + "/reset_simulation", timeout=30.0)
-        reset = rospy.ServiceProxy(SIM + "/reset_simulation", Empty)
+        rospy.wait_for_service(SIM + "/reset_world", timeout=30.0)
+        reset = rospy.ServiceProxy(SIM + "/reset_world", Empty)
         self.assertFalse(rospy.get_param(SIM + "/real_time"), "the soak runs in fast mode")
         pid = node_pid(SIM)
         log_path = self.log_file(pid)

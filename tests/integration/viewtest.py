@@ -1,5 +1,6 @@
-"""Shared helpers of the headless picture suites (view_rviz, view_gui): an Xvfb server, ``view.launch``
-started against the rostest master as a user would start it, screenshots, and rviz's own services.
+"""Shared helpers of the headless picture suites (view_rviz, view_gui): an Xvfb server, ``view.launch`` (or
+``sim.launch``) started against the rostest master as a user would start it, screenshots, and rviz's own
+services.
 
 Callbacks only record; the test thread asserts. Waits poll with deadlines (xscreen.wait_for).
 """
@@ -63,13 +64,14 @@ class SendFilePath:
 
 
 class View:
-    """``roslaunch diffbot_sim view.launch ARGS`` on a fresh Xvfb, on the rostest master.
+    """``roslaunch diffbot_sim LAUNCH ARGS`` (``view.launch`` unless ``launch``) on a fresh Xvfb, on the rostest
+    master.
 
     ``start()`` raises xscreen.XvfbUnavailable when no X server can be had (the only reason to skip).
     """
 
-    def __init__(self, args, log_name):
-        self.args, self.log_name = list(args), log_name
+    def __init__(self, args, log_name, launch="view.launch"):
+        self.args, self.log_name, self.launch = list(args), log_name, launch
         self.xvfb = None
         self.proc = None
         self.lock = threading.Lock()
@@ -89,7 +91,7 @@ class View:
         self.cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
         os.makedirs(self.home, exist_ok=True)
         self.log_file = open(self.log_path, "w")
-        self.proc = subprocess.Popen(["roslaunch", "diffbot_sim", "view.launch"] + self.args,
+        self.proc = subprocess.Popen(["roslaunch", "diffbot_sim", self.launch] + self.args,
                                      env=self.xvfb.env(), stdout=self.log_file, stderr=subprocess.STDOUT,
                                      stdin=subprocess.DEVNULL, start_new_session=True)
         return self
@@ -112,7 +114,7 @@ class View:
     def alive(self):
         """Fail when roslaunch ended: a required node (bullet_sim, rviz) died."""
         if self.proc.poll() is not None:
-            raise AssertionError(f"roslaunch view.launch exited {self.proc.returncode} (see {self.log_path}):\n"
+            raise AssertionError(f"roslaunch {self.launch} exited {self.proc.returncode} (see {self.log_path}):\n"
                                  + self.tail())
 
     def tail(self, lines=15):

@@ -1,0 +1,230 @@
+#!/usr/bin/env python3
+"""view_gui suite: PyBullet's own window (``sim.launch gui:=true``) under Xvfb, judged by its pixels.
+
+The seed robot in worlds/room.world, real time. PyBullet's window opens at 1024 x 768 with its default
+camera (xscreen.PYBULLET_CAMERA: target the origin, 5 m, yaw 50, pitch -35); world points are projected
+with that camera (xscreen.pybullet_pixel; checked against getDebugVisualizerCamera) to say where the robot
+must be drawn. Only the part of the 3-D view no panel covers is judged (xscreen.PYBULLET_SCENE_BOX).
+
+- The world: the room's walls have no colour in the world file, so PyBullet draws them in its palette (red,
+  yellow, green, blue): strongly coloured pixels of each hue (xscreen.saturated) must be there, many. The
+  same count on the frame after ``/gazebo/delete_model walls`` must fail (the red ones are all walls).
+- The robot: frame A with the robot at the origin, frame B with it teleported out of view
+  (``/gazebo/set_model_state``), frame C with it at (1, 0). A - B and C - B must each be one compact patch
+  of changed pixels, at least a robot's worth, centred within CENTRE_TOLERANCE px of where the camera
+  projects the robot's body; A to C must go the way the camera maps +x (to the lower right). Two frames
+  without the robot (B and a later one) differ by far fewer pixels than a robot: the check fails when no
+  robot is drawn.
+"""
+import math
+import os
+import sys
+import unittest
+
+import numpy as np
+import rospy
+import rostest
+from gazebo_msgs.msg import ModelState
+from gazebo_msgs.srv import DeleteModel, GetModelState, GetWorldProperties, SetModelState
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import viewtest  # noqa: E402
+
+from diffbot_sim import xscreen  # noqa: E402
+
+ROOM = os.path.join(viewtest.ROOT, "worlds", "room.world")
+ROBOT = "diffbot"  # the seed robot's URDF name: its model name
+ROBOT_Z = 0.076  # m: the seed robot's body centre above the ground (base_z of diffbot.urdf.xacro)
+AWAY = (30.0, 30.0)  # m: far outside the default camera's view (projects ~8700 px to the right)
+START_TIMEOUT = 40.0  # s wall: master, simulator, PyBullet's window under llvmpipe on a busy 2-core machine
+SETTLE_TIMEOUT = 15.0  # s wall: two equal frames after a change
+SETTLE_PERIOD = 0.5  # s wall between the two frames compared
+SETTLE_CHANGED = 20  # px: "equal" frames differ in at most this many pixels
+#: Strong pixels of each hue the room must show (measured: red 16690, yellow 14742, green 8839, blue 25878
+#: with the walls; red 137, yellow 0, green 127, blue 239 in the empty scene before the world loads).
+WALL_MIN = {"red": 5000, "yellow": 5000, "green": 4000, "blue": 8000}
+ROBOT_MIN_PIXELS = 150  # px changed: the robot's body (0.2 m wide, ~0.13 m high) at 5 m is ~15 x 12 px, plus
+#                         its wheels and shadow
+ROBOT_MAX_PIXELS = 3000  # px changed: more is not the robot alone
+PATCH_RADIUS = 40  # px around the patch's median: the robot and its shadow
+CENTRE_TOLERANCE = 40.0  # px between the patch's centre and the projected body centre
+
+
+class ViewGui(unittest.TestCase):
+    view = None
+    skip_reason = None
+
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_view_gui")
+        cls.view = viewtest.View(["gui:=true", f"world:={ROOM}"], "view_gui_launch", launch="sim.launch")
+        try:
+            cls.view.start()
+        except xscreen.XvfbUnavailable as err:
+            cls.skip_reason = f"Xvfb cannot start here: {err}"
+            print(f"SKIPPED view_gui: {cls.skip_reason}", flush=True)
+            return
+        display = cls.view.xvfb.display
+        cls.window = cls.view.wait(lambda: xscreen.find_window(display, "Bullet Physics"), START_TIMEOUT,
+                                   "PyBullet's window")
+        # The window opens before the simulator builds the world and the robot: wait for both.
+        cls.view.wait(lambda: rospy.has_param("/bullet_sim/world_bodies"), START_TIMEOUT,
+                      "the simulator to load the world (/bullet_sim/world_bodies)")
+        cls.view.wait(lambda: cls.view.last_odom() is not None, START_TIMEOUT, "odometry")
+        for name in ("set_model_state", "get_model_state", "get_world_properties", "delete_model"):
+            cls.view.wait(lambda: cls.service_up(f"/gazebo/{name}"), START_TIMEOUT, f"/gazebo/{name}")
+        cls.set_state = rospy.ServiceProxy("/gazebo/set_model_state", SetModelState)
+        cls.get_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+        cls.world_properties = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
+        cls.delete_model = rospy.ServiceProxy("/gazebo/delete_model", DeleteModel)
+
+    @classmethod
+    def tearDownClass(cls):
+        if cls.view is not None:
+            cls.view.stop()
+
+    def setUp(self):
+        if self.skip_reason:
+            self.skipTest(self.skip_reason)
+
+    # ------------------------------------------------------------------------------------- helpers
+
+    @staticmethod
+    def service_up(name):
+        try:
+            rospy.wait_for_service(name, 0.2)
+            return True
+        except rospy.ROSException:
+            return False
+
+    def call(self, proxy, *args):
+        return viewtest.with_timeout(lambda: proxy(*args), 10.0, proxy.resolved_name)
+
+    def frame(self):
+        """The window's pixels (the window must not have moved or changed size)."""
+        window = xscreen.find_window(self.view.xvfb.display, "Bullet Physics")
+        self.assertIsNotNone(window, "PyBullet's window went away")
+        self.assertEqual((window.width, window.height), xscreen.PYBULLET_WINDOW,
+                         "PyBullet's window is not at its default size: the camera projection does not hold")
+        return xscreen.crop(self.view.screenshot(), window.box())
+
+    def settled(self, what):
+        """A frame once two in a row, SETTLE_PERIOD apart, differ in at most SETTLE_CHANGED pixels."""
+        previous = [None]
+
+        def ready():
+            frame = self.frame()
+            same = previous[0] is not None and int(xscreen.changed(previous[0], frame).sum()) <= SETTLE_CHANGED
+            previous[0] = frame
+            return frame if same else None
+        return self.view.wait(ready, SETTLE_TIMEOUT, what)
+
+    def scene(self, frame):
+        return xscreen.crop(frame, xscreen.PYBULLET_SCENE_BOX)
+
+    def teleport(self, x, y):
+        """Put the robot at (x, y) on the ground (its height and heading kept), at rest; wait until it is."""
+        now = self.call(self.get_state, ROBOT, "world")
+        self.assertTrue(now.success, now.status_message)
+        state = ModelState(model_name=ROBOT, reference_frame="world")
+        state.pose = now.pose
+        state.pose.position.x, state.pose.position.y = x, y
+        answer = self.call(self.set_state, state)
+        self.assertTrue(answer.success, answer.status_message)
+
+        def there():
+            p = self.call(self.get_state, ROBOT, "world").pose.position
+            return math.hypot(p.x - x, p.y - y) < 0.02
+        self.view.wait(there, 10.0, f"the robot at ({x}, {y})")
+
+    def robot_patch(self, with_robot, without, label):
+        """The pixels the robot changes between two frames: ``(count, centroid, stray)`` over the window."""
+        x0, y0 = xscreen.PYBULLET_SCENE_BOX[:2]
+        mask = np.zeros(with_robot.shape[:2], dtype=bool)
+        x1, y1 = xscreen.PYBULLET_SCENE_BOX[2:]
+        mask[y0:y1, x0:x1] = xscreen.changed(with_robot, without)[y0:y1, x0:x1]
+        count, centre, stray = xscreen.patch(mask, PATCH_RADIUS)
+        print(f"view_gui: robot {label}: {count} changed px, centre {centre}, {stray} stray", flush=True)
+        return count, centre, stray
+
+    def check_robot(self, with_robot, without, at, label):
+        count, centre, stray = self.robot_patch(with_robot, without, label)
+        self.assertGreaterEqual(count, ROBOT_MIN_PIXELS, f"{label}: the robot changes {count} pixels "
+                                f"(at least {ROBOT_MIN_PIXELS} expected): no robot drawn")
+        self.assertLessEqual(count, ROBOT_MAX_PIXELS, f"{label}: {count} pixels changed, more than a robot")
+        self.assertLessEqual(stray, 0.2 * count, f"{label}: {stray} changed pixels away from the robot's patch "
+                             f"of {count}")
+        want = xscreen.pybullet_pixel((at[0], at[1], ROBOT_Z))
+        miss = math.hypot(centre[0] - want[0], centre[1] - want[1])
+        print(f"view_gui: robot {label}: drawn at ({centre[0]:.1f}, {centre[1]:.1f}), the camera projects "
+              f"({want[0]:.1f}, {want[1]:.1f}): {miss:.1f} px off", flush=True)
+        self.assertLess(miss, CENTRE_TOLERANCE, f"{label}: robot drawn at pixel {centre}, the camera puts "
+                        f"{at} at {want}: {miss:.1f} px off")
+        return centre
+
+    # --------------------------------------------------------------------------------------- tests
+
+    def test_1_world_drawn(self):
+        names = self.call(self.world_properties).model_names
+        self.assertIn("walls", names)
+        self.assertIn(ROBOT, names)
+        frame = self.settled("PyBullet's window to show the world")
+        viewtest.save_frame(frame, "gui_world")
+        counts = xscreen.color_counts(self.scene(frame))
+        print(f"view_gui: strong colours with the room: {counts}", flush=True)
+        for hue, least in WALL_MIN.items():
+            self.assertGreaterEqual(counts[hue], least, f"{counts[hue]} {hue} pixels, the room's walls give "
+                                    f"{least} or more: the world is not drawn ({counts})")
+        self.view.alive()
+
+    def test_2_robot_where_it_is(self):
+        p = self.call(self.get_state, ROBOT, "world").pose.position
+        self.assertLess(math.hypot(p.x, p.y), 0.05, f"the robot did not spawn at the origin: {p}")
+        at_origin = self.settled("the robot at the origin, drawn")
+        self.teleport(*AWAY)
+        away = self.settled("the robot out of view, drawn")
+        self.teleport(1.0, 0.0)
+        at_x1 = self.settled("the robot at (1, 0), drawn")
+        self.teleport(*AWAY)
+        away_again = self.settled("the robot out of view again, drawn")
+        for image, name in ((at_origin, "origin"), (away, "away"), (at_x1, "x1")):
+            viewtest.save_frame(image, f"gui_robot_{name}")
+
+        first = self.check_robot(at_origin, away, (0.0, 0.0), "at the origin")
+        second = self.check_robot(at_x1, away, (1.0, 0.0), "at (1, 0)")
+        # +x on the screen: where the camera maps it, computed, not assumed.
+        u0, v0 = xscreen.pybullet_pixel((0.0, 0.0, ROBOT_Z))
+        u1, v1 = xscreen.pybullet_pixel((1.0, 0.0, ROBOT_Z))
+        want = np.array([u1 - u0, v1 - v0])
+        moved = np.array([second[0] - first[0], second[1] - first[1]])
+        angle = math.degrees(math.acos(float(np.dot(want, moved) / (np.linalg.norm(want) * np.linalg.norm(moved)))))
+        ratio = float(np.linalg.norm(moved) / np.linalg.norm(want))
+        print(f"view_gui: 1 m along +x moved the robot's pixels by {moved.round(1).tolist()}, the camera says "
+              f"{want.round(1).tolist()}: {angle:.1f} deg apart, length ratio {ratio:.2f}", flush=True)
+        self.assertLess(angle, 20.0, f"+x moved the robot's picture by {moved}, the camera maps it to {want}")
+        self.assertTrue(0.7 < ratio < 1.4, f"+x moved the robot's picture by {moved}, the camera: {want}")
+
+        # Without a robot in either frame the same check finds no patch worth a robot.
+        count, _, _ = self.robot_patch(away_again, away, "in neither frame")
+        self.assertLess(count, ROBOT_MIN_PIXELS, f"two frames without the robot differ in {count} pixels: the "
+                        "robot check cannot tell a drawn robot from none")
+        self.view.alive()
+
+    def test_3_world_check_fails_without_walls(self):
+        answer = self.call(self.delete_model, "walls")
+        self.assertTrue(answer.success, answer.status_message)
+        self.view.wait(lambda: "walls" not in self.call(self.world_properties).model_names, 10.0,
+                       "the walls to go")
+        frame = self.settled("PyBullet's window without the walls")
+        viewtest.save_frame(frame, "gui_no_walls")
+        counts = xscreen.color_counts(self.scene(frame))
+        print(f"view_gui: strong colours without the walls: {counts}", flush=True)
+        self.assertLess(counts["red"], WALL_MIN["red"], f"{counts['red']} red pixels without the walls: "
+                        "test_1's check would not notice the walls missing")
+        short = [hue for hue, least in WALL_MIN.items() if counts[hue] < least]
+        self.assertTrue(short, f"every colour still reaches WALL_MIN without the walls: {counts}")
+        self.view.alive()
+
+
+if __name__ == "__main__":
+    rostest.rosrun("diffbot_sim", "view_gui", ViewGui, sys.argv)
