@@ -16,7 +16,7 @@ import re
 from xml.parsers import expat
 from xml.sax.saxutils import escape
 
-from .world_sdf import compose, inverse, rpy_quaternion
+from .world_sdf import compose, inverse, rotate, rpy_quaternion
 
 IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
@@ -87,18 +87,9 @@ def find_entity(name, scoped_names):
 
 # ------------------------------------------------------------------------------------------ pose math
 
-def _rotate(q, v):
-    """Vector ``v`` turned by the unit quaternion ``q`` (x, y, z, w)."""
-    x, y, z, w = q
-    cx, cy, cz = y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0]
-    return (v[0] + 2 * (w * cx + y * cz - z * cy),
-            v[1] + 2 * (w * cy + z * cx - x * cz),
-            v[2] + 2 * (w * cz + x * cy - y * cx))
-
-
 def _unrotate(q, v):
     """``v`` turned by the inverse of the unit quaternion ``q`` (ignition's RotateVectorReverse)."""
-    return _rotate((-q[0], -q[1], -q[2], q[3]), v)
+    return rotate((-q[0], -q[1], -q[2], q[3]), v)
 
 
 def _unit(q):
@@ -188,9 +179,9 @@ def world_state(pose_in_frame, twist_in_frame, frame_pose, frame_twist, conventi
     (v, w), (vf, wf) = (_floats(c) for c in twist_in_frame), (_floats(c) for c in frame_twist)
     pose = compose(frame_pose, pose_in_frame)
     if convention == INVERSE:
-        return pose, (_add(_rotate(qf, v), vf), _add(_rotate(qf, w), wf))
+        return pose, (_add(rotate(qf, v), vf), _add(rotate(qf, w), wf))
     if convention == SET_MODEL_STATE:
-        return pose, (_rotate(qf, v), _rotate(qf, w))
+        return pose, (rotate(qf, v), rotate(qf, w))
     if convention == SET_LINK_STATE:
         return pose, (_sub(v, vf), _sub(w, wf))
     raise ValueError(f"world_state: convention '{convention}' is not one of "
@@ -560,8 +551,8 @@ def wrench_to_world(force, torque, reference_point, frame_pose, body_pose=None):
     if body_pose is None:
         raise ValueError("wrench_to_world: body_pose is needed with a reference frame")
     tr_p, tr_q = compose(inverse(_pose(body_pose)), _pose(frame_pose))
-    f = _rotate(tr_q, f)
-    t = _add(_rotate(tr_q, t), _cross(tr_p, f))
+    f = rotate(tr_q, f)
+    t = _add(rotate(tr_q, t), _cross(tr_p, f))
     return f, t, None
 
 

@@ -83,7 +83,8 @@ def _qnorm(q):
     return tuple(c / n for c in q)
 
 
-def _rotate(q, v):
+def rotate(q, v):
+    """Vector ``v`` turned by the unit quaternion ``q`` (x, y, z, w)."""
     x, y, z, w = q
     # v + 2 w (u x v) + 2 u x (u x v), with u the vector part: no matrix needed.
     cx, cy, cz = y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0]
@@ -95,7 +96,7 @@ def _rotate(q, v):
 def compose(a, b):
     """``a * b``: pose ``b`` (given in frame ``a``) expressed in ``a``'s parent frame."""
     (pa, qa), (pb, qb) = a, b
-    p = _rotate(qa, pb)
+    p = rotate(qa, pb)
     return ((pa[0] + p[0], pa[1] + p[1], pa[2] + p[2]), _qnorm(_qmul(qa, qb)))
 
 
@@ -103,7 +104,7 @@ def inverse(a):
     """The pose that undoes ``a``: ``compose(a, inverse(a)) == IDENTITY``."""
     p, (x, y, z, w) = a
     qi = (-x, -y, -z, w)
-    r = _rotate(qi, p)
+    r = rotate(qi, p)
     return ((-r[0], -r[1], -r[2]), qi)
 
 

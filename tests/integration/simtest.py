@@ -28,6 +28,35 @@ def finite_odom(msg):
     return all(math.isfinite(x) for x in (p.x, p.y, p.z, q.x, q.y, q.z, q.w, v.x, v.y, v.z, w.x, w.y, w.z))
 
 
+def wait_for(predicate, timeout, what, poll=0.02):
+    """Poll ``predicate`` until it returns something true (returned) or ``timeout`` wall seconds pass
+    (AssertionError naming ``what``)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and not rospy.is_shutdown():
+        value = predicate()
+        if value:
+            return value
+        time.sleep(poll)
+    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+
+
+class Latest:
+    """The newest message of one topic and how many arrived (the callback only stores)."""
+
+    def __init__(self, topic, kind):
+        self.lock = threading.Lock()
+        self.msg, self.count = None, 0
+        self.sub = rospy.Subscriber(topic, kind, self._keep, queue_size=10)
+
+    def _keep(self, msg):
+        with self.lock:
+            self.msg, self.count = msg, self.count + 1
+
+    def get(self):
+        with self.lock:
+            return self.msg
+
+
 class Recorder:
     """Subscribes the standard topics and keeps every message with its receipt time."""
 

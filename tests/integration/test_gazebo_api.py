@@ -12,7 +12,6 @@ cmd_vel, odom in its plugin's robotNamespace).
 import math
 import os
 import sys
-import threading
 import time
 import unittest
 
@@ -26,6 +25,9 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty
 
+from simtest import Latest, yaw_of
+from simtest import wait_for as wait
+
 GZ = "/gazebo"
 ROBOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "robots", "fixed_caster.urdf")
 
@@ -37,37 +39,6 @@ def proxy(name, kind):
 
 def pose(x=0.0, y=0.0, z=0.0, yaw=0.0):
     return Pose(Point(x, y, z), Quaternion(0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)))
-
-
-def yaw_of(q):
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-
-
-def wait(predicate, timeout, what):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline and not rospy.is_shutdown():
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.02)
-    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-
-
-class Latest:
-    """The newest message of a topic (callbacks only store)."""
-
-    def __init__(self, topic, kind):
-        self.lock = threading.Lock()
-        self.msg, self.count = None, 0
-        self.sub = rospy.Subscriber(topic, kind, self._keep, queue_size=10)
-
-    def _keep(self, msg):
-        with self.lock:
-            self.msg, self.count = msg, self.count + 1
-
-    def get(self):
-        with self.lock:
-            return self.msg
 
 
 def publishers_of(topic):

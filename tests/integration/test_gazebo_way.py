@@ -8,7 +8,6 @@ them, all facing +y; the wall's near face is the plane y = 5 (wall.world).
 """
 import math
 import sys
-import threading
 import time
 import unittest
 
@@ -20,36 +19,10 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState, LaserScan
 
+from simtest import Latest, yaw_of
+from simtest import wait_for as wait
+
 WALL_Y = 5.0
-
-
-def yaw_of(q):
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-
-
-def wait(predicate, timeout, what):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline and not rospy.is_shutdown():
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.05)
-    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-
-
-class Latest:
-    def __init__(self, topic, kind):
-        self.lock = threading.Lock()
-        self.msg = None
-        self.sub = rospy.Subscriber(topic, kind, self._keep, queue_size=5)
-
-    def _keep(self, msg):
-        with self.lock:
-            self.msg = msg
-
-    def get(self):
-        with self.lock:
-            return self.msg
 
 
 class GazeboWayTest(unittest.TestCase):
