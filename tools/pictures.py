@@ -7,7 +7,8 @@
 2. The last of those runs drives a scripted path (forward, turn, forward, arc) while this process records
    odometry, ground truth, commands, the scan and TF; then ``docs/rviz.png`` (the rviz window) and
    ``docs/run.png`` (``plot_run``'s picture of the recording).
-3. ``view.launch gui:=true rviz:=false`` drives a little and ``docs/pybullet.png`` is PyBullet's window.
+3. ``view.launch gui:=true rviz:=false``: ``docs/pybullet.png`` is PyBullet's window once the simulator has
+   built the world and the robot and the window's 3-D view has stopped changing.
 
 Every process is started in its own session and stopped by its process group; each run has its own master
 (``roslaunch -p PORT``). Prints one line per step, so a reader knows it is alive (about 1 min in all).
@@ -32,6 +33,8 @@ WORLD = os.path.join(ROOT, "worlds", "room.world")
 RUNS = 3
 YELLOW_PIXELS = 100  # the robot's top (0.26 x 0.18 m) covers ~500 pixels in the fitted top view
 MAX_WIDTH = 960  # px: pictures are scaled to this width (and palette-reduced) to stay under 200 KB
+SETTLE_PERIOD = 0.5  # s wall between two screenshots of PyBullet's window compared
+SETTLE_CHANGED = 20  # px: two frames differing in at most this many pixels show the same, finished scene
 
 
 def say(text):
@@ -100,6 +103,38 @@ def first_frame(display, args, log):
         return robot_drawn(display)
     xscreen.wait_for(ready, 120, "the first rviz frame with the robot", period=0.05)
     return launch, time.monotonic() - launch.started
+
+
+def pybullet_frame(display, launch):
+    """PyBullet's window once it shows the world and the robot: its pixels.
+
+    The window opens, and draws PyBullet's own grid, before the simulator has built the world and the robot:
+    wait for the simulator to say it is built (``/bullet_sim/world_bodies``, set after loading the world and
+    the robots), then until two frames of the 3-D view ``SETTLE_PERIOD`` s apart are nearly equal (the scene
+    is drawn)."""
+    import rosgraph
+
+    master = rosgraph.Master("/pictures", master_uri=launch.env["ROS_MASTER_URI"])
+
+    def built():
+        launch.check()
+        try:
+            return master.hasParam("/bullet_sim/world_bodies")
+        except Exception:  # the master is not up yet
+            return False
+    window = xscreen.wait_for(lambda: launch.check() or xscreen.find_window(display, "Bullet Physics"), 60,
+                              "PyBullet's window")
+    xscreen.wait_for(built, 60, "the simulator to load the world and the robot (/bullet_sim/world_bodies)")
+    previous = [None]
+
+    def settled():
+        launch.check()
+        frame = xscreen.crop(xscreen.screenshot(display), window.box())
+        scene = xscreen.crop(frame, xscreen.PYBULLET_SCENE_BOX)
+        same = previous[0] is not None and int(xscreen.changed(previous[0], scene).sum()) <= SETTLE_CHANGED
+        previous[0] = scene
+        return (frame,) if same and scene.std() > 20 else None
+    return xscreen.wait_for(settled, 60, "PyBullet to draw the scene (two equal frames)", SETTLE_PERIOD)[0]
 
 
 class Recorder:
@@ -178,13 +213,8 @@ def main():
         say("PyBullet's window: view.launch gui:=true rviz:=false")
         gui = Launch(x.display, args + ["gui:=true", "rviz:=false"], os.path.join(logs, "gui.log"))
         try:
-            window = xscreen.wait_for(lambda: gui.check() or xscreen.find_window(x.display, "Bullet Physics"),
-                                      60, "PyBullet's window")
-            # PyBullet's first frames are a flat background: wait until the window shows the scene.
-            xscreen.wait_for(lambda: xscreen.crop(xscreen.screenshot(x.display), window.box()).std() > 20, 60,
-                             "PyBullet to draw the scene")
-            xscreen.save_png(xscreen.crop(xscreen.screenshot(x.display), window.box()),
-                             os.path.join(DOCS, "pybullet.png"), MAX_WIDTH)
+            frame = pybullet_frame(x.display, gui)
+            xscreen.save_png(frame, os.path.join(DOCS, "pybullet.png"), MAX_WIDTH)
             say("docs/pybullet.png")
         finally:
             gui.stop()
