@@ -84,13 +84,17 @@ def count_junit(paths):
             failed += 1
             names.append(f"{os.path.basename(path)}: unreadable result file ({err})")
             continue
+        # rosunit writes no <skipped> for a unittest skip; a suite that skips says "SKIPPED <why>" on its
+        # stdout (the picture suites, where Xvfb cannot start), which rosunit keeps in <system-out>.
+        said_skip = any(line.startswith("SKIPPED ") for out in root.iter("system-out")
+                        for line in (out.text or "").splitlines())
         for case in root.iter("testcase"):
             name = f"{case.get('classname', '')}.{case.get('name', '')}"
             bad = case.find("failure") if case.find("failure") is not None else case.find("error")
             if bad is not None:
                 failed += 1
                 names.append(f"{name}: {_why(bad)}")
-            elif case.find("skipped") is not None:
+            elif case.find("skipped") is not None or said_skip:
                 skipped += 1
             else:
                 passed += 1
@@ -140,9 +144,22 @@ def run_rostest(test_file):
         failed, names = s_failed, s_names  # e.g. "test node did not generate test results" (it crashed)
     if code != 0 and failed == 0:
         failed, names = failed + 1, names + [f"{name}: rostest exited {code} (see {log_path})"]
-    if passed + failed == 0:
+    if passed + failed + skipped == 0:
         failed, names = 1, [f"{name}: ran no test (see {log_path})"]
     return name, passed, failed, skipped, names, time.monotonic() - started
+
+
+def _skip_reason(name):
+    """The "SKIPPED <why>" line a rostest suite printed (kept in its result files), for the report."""
+    for path in glob.glob(os.path.join(RESULTS, "rostest", name, "**", "*.xml"), recursive=True):
+        try:
+            with open(path, errors="replace") as result:
+                for line in result:
+                    if line.startswith("SKIPPED "):
+                        return line[len("SKIPPED "):].strip()
+        except OSError:
+            continue
+    return "no reason printed"
 
 
 def main():
@@ -170,7 +187,8 @@ def main():
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         for phase in phases:
             for name, p, f, s, n, secs in pool.map(run_rostest, phase):
-                say(f"[tests] rostest {name}: {p} passed, {f} failed ({secs:.0f} s)")
+                skips = f", {s} skipped: {_skip_reason(name)}" if s else ""
+                say(f"[tests] rostest {name}: {p} passed, {f} failed{skips} ({secs:.0f} s)")
                 total_p, total_f, total_s = total_p + p, total_f + f, total_s + s
                 failures += n
     for name in failures:
