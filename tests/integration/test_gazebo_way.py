@@ -89,7 +89,12 @@ class GazeboWayTest(unittest.TestCase):
             while rospy.get_time() < t0 + 2.0 and time.monotonic() < deadline:
                 pub.publish(cmd)  # the YAML's cmd_vel_timeout is 0.25 s: keep commanding
                 time.sleep(0.05)
-            pub.publish(Twist())
+            # stopped: the zero command arrives (its cmd_vel_timeout brakes it anyway) before the next robot
+            def stopped():
+                pub.publish(Twist())
+                v = self.state(robot["model"]).twist.linear
+                return math.hypot(v.x, v.y) < 0.01
+            wait(stopped, 10.0, f"{robot['model']} at rest after the drive")
             end = self.state(robot["model"]).pose.position
             self.assertGreater(end.y - start.y, 0.4, f"{robot['model']} drove forward (+y)")
             self.assertLess(end.y, WALL_Y - 0.2)
