@@ -270,7 +270,7 @@ class GazeboApi:
             response.status_message = result if isinstance(result, str) else "ok"
         except (RequestError, ValueError, DiffbotSimError) as err:
             response.success = False
-            response.status_message = f"{type(self).__name__.replace('Api', '')}: {err}"
+            response.status_message = str(err)
             rospy.logwarn(f"{self.ns}: {response.status_message}")
         return response
 
