@@ -1,0 +1,40 @@
+"""How ~world / empty_world.launch's world_name is found: as given, else in GAZEBO_RESOURCE_PATH, else in
+this package (which ships Gazebo's default worlds/empty.world)."""
+import os
+
+import pytest
+
+from diffbot_sim.errors import ModelError
+from diffbot_sim.nodes.sim_node import resolve_world_path
+from diffbot_sim.world_sdf import read_world
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def test_gazebo_default_world_is_ours(monkeypatch, tmp_path):
+    monkeypatch.delenv("GAZEBO_RESOURCE_PATH", raising=False)
+    monkeypatch.chdir(tmp_path)
+    path = resolve_world_path("worlds/empty.world", ROOT)
+    assert path == os.path.join(ROOT, "worlds", "empty.world")
+    world = read_world(path, model_paths=[])
+    assert [b.top_model for b in world.bodies] == ["ground_plane"] and world.has_ground
+
+
+def test_gazebo_resource_path_comes_first(monkeypatch, tmp_path):
+    (tmp_path / "worlds").mkdir()
+    (tmp_path / "worlds" / "empty.world").write_text("<sdf version='1.6'><world name='x'/></sdf>")
+    monkeypatch.setenv("GAZEBO_RESOURCE_PATH", f"/nonexistent:{tmp_path}")
+    monkeypatch.chdir("/")
+    assert resolve_world_path("worlds/empty.world", ROOT) == str(tmp_path / "worlds" / "empty.world")
+
+
+def test_a_missing_world_names_itself_and_where_it_looked(monkeypatch, tmp_path):
+    monkeypatch.setenv("GAZEBO_RESOURCE_PATH", str(tmp_path))
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ModelError) as err:
+        resolve_world_path("worlds/willowgarage.world", ROOT)
+    assert "worlds/willowgarage.world" in str(err.value) and "GAZEBO_RESOURCE_PATH" in str(err.value)
+    absent = str(tmp_path / "absent.world")  # an absolute path is taken as given; the reader names it
+    assert resolve_world_path(absent, ROOT) == absent
+    with pytest.raises(ModelError, match="absent.world"):
+        read_world(absent)
