@@ -20,7 +20,6 @@ must be drawn. Only the part of the 3-D view no panel covers is judged (xscreen.
 import math
 import os
 import sys
-import unittest
 
 import numpy as np
 import rospy
@@ -53,19 +52,12 @@ PATCH_RADIUS = 40  # px around the patch's median: the robot and its shadow
 CENTRE_TOLERANCE = 40.0  # px between the patch's centre and the projected body centre
 
 
-class ViewGui(unittest.TestCase):
-    view = None
-    skip_reason = None
-
+class ViewGui(viewtest.PictureSuite):
     @classmethod
     def setUpClass(cls):
         rospy.init_node("test_view_gui")
-        cls.view = viewtest.View(["gui:=true", f"world:={ROOM}"], "view_gui_launch", launch="sim.launch")
-        try:
-            cls.view.start()
-        except xscreen.XvfbUnavailable as err:
-            cls.skip_reason = f"Xvfb cannot start here: {err}"
-            print(f"SKIPPED view_gui: {cls.skip_reason}", flush=True)
+        if not cls.start_view("view_gui", viewtest.View(["gui:=true", f"world:={ROOM}"], "view_gui_launch",
+                                                        launch="sim.launch")):
             return
         display = cls.view.xvfb.display
         cls.window = cls.view.wait(lambda: xscreen.find_window(display, "Bullet Physics"), START_TIMEOUT,
@@ -80,15 +72,6 @@ class ViewGui(unittest.TestCase):
         cls.get_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
         cls.world_properties = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
         cls.delete_model = rospy.ServiceProxy("/gazebo/delete_model", DeleteModel)
-
-    @classmethod
-    def tearDownClass(cls):
-        if cls.view is not None:
-            cls.view.stop()
-
-    def setUp(self):
-        if self.skip_reason:
-            self.skipTest(self.skip_reason)
 
     # ------------------------------------------------------------------------------------- helpers
 

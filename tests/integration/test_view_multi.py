@@ -17,7 +17,6 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import viewtest  # noqa: E402
 from test_view_rviz import START_TIMEOUT, ViewRviz  # noqa: E402
 
-from diffbot_sim import xscreen  # noqa: E402
 
 ROBOT2 = (0.0, 1.0)  # m, multi.launch's spawn pose of robot2; robot1 (the fixed frame's) is at the origin
 
@@ -26,12 +25,8 @@ class ViewMulti(ViewRviz):
     @classmethod
     def setUpClass(cls):
         rospy.init_node("test_view_multi")
-        cls.view = viewtest.View([f"world:={viewtest.WORLD}"], "view_multi_launch", launch="view_multi.launch")
-        try:
-            cls.view.start()
-        except xscreen.XvfbUnavailable as err:
-            cls.skip_reason = f"Xvfb cannot start here: {err}"
-            print(f"SKIPPED view_multi: {cls.skip_reason}", flush=True)
+        if not cls.start_view("view_multi", viewtest.View([f"world:={viewtest.WORLD}"], "view_multi_launch",
+                                                          launch="view_multi.launch")):
             return
         cls.tmp = tempfile.mkdtemp(prefix="view_multi_")
         cls.view.wait(lambda: cls.rviz_window(), START_TIMEOUT, "the rviz window")

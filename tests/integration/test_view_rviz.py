@@ -18,7 +18,6 @@ import math
 import os
 import sys
 import tempfile
-import unittest
 
 import numpy as np
 import rospy
@@ -38,19 +37,12 @@ CENTRE_TOLERANCE = 0.05
 PATCH_RADIUS = 0.3  # m: the robot's top fits in this circle (half-diagonal 0.16 m), the next wall does not  # m: the laser and camera visuals shift the patch's centre forward ~1 cm
 
 
-class ViewRviz(unittest.TestCase):
-    view = None
-    skip_reason = None
-
+class ViewRviz(viewtest.PictureSuite):
     @classmethod
     def setUpClass(cls):
         rospy.init_node("test_view_rviz")
-        cls.view = viewtest.View([f"model:={viewtest.ROBOT}", f"world:={viewtest.WORLD}"], "view_rviz_launch")
-        try:
-            cls.view.start()
-        except xscreen.XvfbUnavailable as err:
-            cls.skip_reason = f"Xvfb cannot start here: {err}"
-            print(f"SKIPPED view_rviz: {cls.skip_reason}", flush=True)
+        if not cls.start_view("view_rviz", viewtest.View([f"model:={viewtest.ROBOT}", f"world:={viewtest.WORLD}"],
+                                                         "view_rviz_launch")):
             return
         cls.tmp = tempfile.mkdtemp(prefix="view_rviz_")
         cls.view.wait(lambda: cls.rviz_window(), START_TIMEOUT, "the rviz window")
@@ -61,15 +53,6 @@ class ViewRviz(unittest.TestCase):
         cls.full = viewtest.config_variant(cls.config, os.path.join(cls.tmp, "full.rviz"))
         cls.no_model = viewtest.config_variant(cls.config, os.path.join(cls.tmp, "no_model.rviz"), RobotModel=False)
         cls.no_scan = viewtest.config_variant(cls.config, os.path.join(cls.tmp, "no_scan.rviz"), LaserScan=False)
-
-    @classmethod
-    def tearDownClass(cls):
-        if cls.view is not None:
-            cls.view.stop()
-
-    def setUp(self):
-        if self.skip_reason:
-            self.skipTest(self.skip_reason)
 
     # ------------------------------------------------------------------------------------- helpers
 

@@ -10,6 +10,7 @@ import struct
 import subprocess
 import threading
 import time
+import unittest
 import xmlrpc.client
 
 import genpy
@@ -195,6 +196,36 @@ class View:
 
     def screenshot(self):
         return xscreen.screenshot(self.xvfb.display)
+
+
+class PictureSuite(unittest.TestCase):
+    """What the picture suites share: a View started on Xvfb, stopped at the end, and every test skipped
+    (with the reason printed as ``SKIPPED <suite>: <why>``, which the runner reports) only when Xvfb cannot
+    start."""
+
+    view = None
+    skip_reason = None
+
+    @classmethod
+    def start_view(cls, suite, view):
+        """Start ``view``; False (the suite skips) when no X server can be had."""
+        cls.view = view
+        try:
+            view.start()
+        except xscreen.XvfbUnavailable as err:
+            cls.skip_reason = f"Xvfb cannot start here: {err}"
+            print(f"SKIPPED {suite}: {cls.skip_reason}", flush=True)
+            return False
+        return True
+
+    @classmethod
+    def tearDownClass(cls):
+        if cls.view is not None:
+            cls.view.stop()
+
+    def setUp(self):
+        if self.skip_reason:
+            self.skipTest(self.skip_reason)
 
 
 def with_timeout(call, timeout, what):

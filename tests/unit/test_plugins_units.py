@@ -128,7 +128,7 @@ def _param_server(tree, monkeypatch):
                 return default
             node = node[part]
         return node
-    monkeypatch.setattr(ros_control, "_param", _param)
+    monkeypatch.setattr(ros_control, "get_param", _param)
 
 
 DDC = {"type": "diff_drive_controller/DiffDriveController", "left_wheel": "l", "right_wheel": "r"}

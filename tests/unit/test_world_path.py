@@ -5,7 +5,7 @@ import os
 import pytest
 
 from diffbot_sim.errors import ModelError
-from diffbot_sim.nodes.sim_node import resolve_world_path
+from diffbot_sim.description import resolve_world_path
 from diffbot_sim.world_sdf import read_world
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))

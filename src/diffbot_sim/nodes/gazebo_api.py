@@ -21,12 +21,12 @@ from gazebo_msgs import msg as gmsg
 from gazebo_msgs import srv as gsrv
 from geometry_msgs.msg import Pose, Twist, Vector3
 from std_msgs.msg import Header
-from std_srvs.srv import Empty, EmptyResponse
+from std_srvs.srv import Empty
 
 from .. import meshes, world_api
 from ..description import package_path
 from ..errors import DiffbotSimError
-from ..plugins.base import publisher
+from ..plugins.base import close_handle, publisher
 from ..world_sdf import compose, inverse
 
 #: Time a spawn may take on the loop (mesh conversion of a large model), before the caller gives up.
@@ -146,6 +146,7 @@ class GazeboApi:
         self.model_states_pub = publisher(self.ns + "/model_states", gmsg.ModelStates)
         self.link_states_pub = publisher(self.ns + "/link_states", gmsg.LinkStates)
         self.handles = []
+        self._models = None  # {name: entity}, built on first use and again after a spawn or a delete
 
     # -- the loop's side (called on its thread, like a plugin) --------------------------------------
     def publishers(self):
@@ -194,7 +195,13 @@ class GazeboApi:
 
     # -- models ------------------------------------------------------------------------------------
     def models(self):
-        """{name: entity}: world-file models in file order, then robots in spawn order."""
+        """{name: entity}: world-file models in file order, then robots in spawn order. Built once and again
+        only after a spawn or a delete (model_states asks every step)."""
+        if self._models is None:
+            self._models = self._build_models()
+        return self._models
+
+    def _build_models(self):
         out = {}
         for uid, body in self.sim.world.world_bodies:
             out.setdefault(body.top_model, []).append((uid, body))
@@ -255,7 +262,7 @@ class GazeboApi:
         service("clear_body_wrenches", gsrv.BodyRequest, self._clear_wrenches)
         for name, action in (("pause_physics", self.sim.pause), ("unpause_physics", self.sim.unpause),
                              ("reset_simulation", self.sim.reset_simulation), ("reset_world", self.sim.reset_world)):
-            service(name, Empty, lambda _req, action=action: self._empty(action))
+            service(name, Empty, lambda _req, action=action: self.sim.empty_service(action))
         self.handles.append(rospy.Subscriber(f"{ns}/set_model_state", gmsg.ModelState, self._on_model_state,
                                              queue_size=10))
         self.handles.append(rospy.Subscriber(f"{ns}/set_link_state", gmsg.LinkState, self._on_link_state,
@@ -274,16 +281,18 @@ class GazeboApi:
             rospy.logwarn(f"{self.ns}: {response.status_message}")
         return response
 
-    def _empty(self, action):
-        self.sim.call(action)
-        return EmptyResponse()
-
     # spawn / delete
     def _spawn(self, req, service_kind):
         response = gsrv.SpawnModelResponse()
         return self._run(lambda: self._spawn_on_loop(req, service_kind), response, SPAWN_TIMEOUT)
 
     def _spawn_on_loop(self, req, service_kind):
+        try:
+            return self._spawn_checked(req, service_kind)
+        finally:
+            self._models = None  # a robot or bodies may have joined
+
+    def _spawn_checked(self, req, service_kind):
         name = req.model_name
         if not name or "::" in name or "/" in name:
             raise RequestError(f"SpawnModel: model_name '{name}' is not a valid model name")
@@ -330,6 +339,7 @@ class GazeboApi:
             else:
                 for uid, _ in entity.bodies:
                     self.sim.world.remove_body(uid)
+            self._models = None
             self.wrenches.clear_model(req.model_name)
             return f"DeleteModel: successfully deleted model '{req.model_name}'"
         return self._run(action, response)
@@ -517,7 +527,4 @@ class GazeboApi:
 
     def close(self):
         for handle in self.handles:
-            if isinstance(handle, rospy.Service):
-                handle.shutdown("closing")
-            else:
-                handle.unregister()
+            close_handle(handle)

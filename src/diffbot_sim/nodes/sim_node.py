@@ -29,12 +29,12 @@ from tf2_msgs.msg import TFMessage
 
 from .. import config as cfgmod
 from .. import meshes, ros_msgs, streams
-from ..description import load_file, package_path, parse_args
+from ..description import load_file, load_world, package_path, parse_args
 from ..errors import DiffbotSimError, ModelError
-from ..model import parse_urdf
+from ..model import parse_urdf, tag_value
 from ..physics import World
 from ..plugins import read_plugins, registry
-from ..plugins.base import RobotContext, next_due, publisher
+from ..plugins.base import RobotContext, get_param, next_due, publisher
 from ..throttle import Throttle
 
 _CONTROLLER_SUFFIX = {"VelocityJointInterface": "velocity", "EffortJointInterface": "effort",
@@ -283,10 +283,6 @@ class Simulator:
             self.cfg.real_time = False
         self._rebase()
 
-    def stamp(self):
-        """The current sim time as a rospy.Time."""
-        return self._stamp()
-
     @property
     def sim_time(self):
         return self.steps * self.cfg.time_step
@@ -296,7 +292,8 @@ class Simulator:
         self.wall0 = time.monotonic()
         self.sim0 = self.sim_time
 
-    def _empty(self, action):
+    def empty_service(self, action):
+        """A std_srvs/Empty handler's body: ``action`` run on the loop."""
         self.call(action)
         return EmptyResponse()
 
@@ -308,7 +305,7 @@ class Simulator:
             return
         for name, action in (("pause_physics", self.pause), ("unpause_physics", self.unpause),
                              ("reset_simulation", self.reset_simulation), ("reset_world", self.reset_world)):
-            rospy.Service("~" + name, Empty, lambda _req, action=action: self._empty(action))
+            rospy.Service("~" + name, Empty, lambda _req, action=action: self.empty_service(action))
 
     # -- the loop -----------------------------------------------------------------------------------
     def run(self):
@@ -362,7 +359,7 @@ class Simulator:
             if self.links.held_since is not None:
                 self.links.release_if_due(time.monotonic())
             return  # most steps publish nothing: skip building a stamp and asking every robot
-        stamp = self._stamp()
+        stamp = self.stamp()
         wall = time.monotonic()
         self.links.tune_new(wall)
         self.links.hold(wall)
@@ -380,13 +377,13 @@ class Simulator:
                                  + ([self.api.next_publish()] if self.api is not None else []))
         self.links.release_if_due(wall)
 
-    def _stamp(self):
+    def stamp(self):
         """Sim time as a rospy.Time, via integer nanoseconds (cheaper than Time.from_sec's float path)."""
         secs, nsecs = divmod(round(self.steps * self.cfg.time_step * 1e9), 1_000_000_000)
         return rospy.Time(secs, nsecs)
 
     def _publish_clock(self, now):
-        stamp = self._stamp()
+        stamp = self.stamp()
         if self.owns_clock:
             rospy.rostime._set_rostime(stamp)  # this node's own sim time (see _own_the_clock)
         if self.clock_pub.get_num_connections():
@@ -445,6 +442,8 @@ def _build_robot(sim, cfg, spec, params, loaded=None, pose=None, now=None):
     else:
         robot = sim.world.load_robot(text, model, pose[0], orientation=pose[1])
         namespace = None  # a spawn request's robot_namespace is already in its plugins' <robotNamespace>
+        if spec.tf_prefix is None:
+            spec.tf_prefix = _spawned_tf_prefix(model)
     ctx = RobotContext(sim, cfg, spec, model, robot, params, namespace, f"~{spec.name}/" if spec.name else "~")
     try:
         runtime = RobotRuntime(spec.name or model.name, ctx, registry.build(ctx, found, params))
@@ -458,69 +457,27 @@ def _build_robot(sim, cfg, spec, params, loaded=None, pose=None, now=None):
 
 def spawn_robot(sim, cfg, params, name, text, source, pose):
     """A robot spawned while running (/gazebo/spawn_urdf_model): every plugin, sensor and controller it
-    would get at start; its frames get the ``tf_prefix`` parameter of its namespace when one is set (as
-    gazebo_ros plugins read it), else none. Returns its RobotRuntime; raises DiffbotSimError on bad input."""
-    from ..model import parse_urdf as _parse
-    model_ns = ""
-    for plugin_ns in _plugin_namespaces(_parse(text, source)):
-        model_ns = plugin_ns
-        break
-    prefix = _param(rospy.names.ns_join(model_ns or "/", "tf_prefix"), "") if model_ns else ""
-    spec = cfgmod.RobotSpec(name=name, tf_prefix=str(prefix).strip("/"))
+    would get at start. Returns its RobotRuntime; raises DiffbotSimError on bad input."""
+    spec = cfgmod.RobotSpec(name=name)
     item = _build_robot(sim, cfg, spec, params, loaded=(text, source), pose=pose, now=sim.sim_time)
     _report_robot(cfg, item)
     return item.runtime
 
 
-def _plugin_namespaces(model):
-    """The ``robotNamespace`` values of a model's plugins (the spawn request's, once injected)."""
-    from ..model import tag_value
+def _spawned_tf_prefix(model):
+    """A spawned robot's frames get the ``tf_prefix`` parameter of its plugins' namespace (the spawn
+    request's, once injected) when one is set, as gazebo_ros plugins read it; else none."""
     for block in model.gazebo:
         for element in block.element.iter("robotNamespace"):
-            value = tag_value(element)
-            if value:
-                yield value
-
-
-def _param(name, default):
-    try:
-        return rospy.get_param(name, default)
-    except (KeyError, rospy.ROSException):
-        return default
-
-
-def resolve_world_path(name, package_root=None):
-    """The world file ``name`` names: a path as given (absolute, or relative to the working directory),
-    else, as gzserver does, relative to each GAZEBO_RESOURCE_PATH directory, then to this package (which
-    ships ``worlds/empty.world``, empty_world.launch's default).
-
-    Raises:
-        ModelError: naming the world and every directory searched.
-    """
-    path = os.path.abspath(os.path.expanduser(name))
-    if os.path.isfile(path) or os.path.isabs(os.path.expanduser(name)):
-        return path
-    package_root = package_root or os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(
-        os.path.realpath(__file__)))))
-    dirs = [d for d in os.environ.get("GAZEBO_RESOURCE_PATH", "").split(":") if d] + [package_root]
-    for directory in dirs:
-        candidate = os.path.join(directory, name)
-        if os.path.isfile(candidate):
-            return candidate
-    raise ModelError(f"no such world file (searched the working directory, GAZEBO_RESOURCE_PATH and "
-                     f"{package_root})", name)
+            namespace = tag_value(element)
+            if namespace:
+                return str(get_param(rospy.names.ns_join(namespace, "tf_prefix"), "")).strip("/")
+    return ""
 
 
 def _read_world(cfg):
     """The world file's description (SDF .world, or a map_server .yaml), or None without ``~world``."""
-    if not cfg.world:
-        return None
-    path = resolve_world_path(cfg.world)
-    if path.endswith((".yaml", ".yml")):
-        from ..world_map import read_map
-        return read_map(path, cfg.map_wall_height)
-    from ..world_sdf import read_world, ros_package_model_paths
-    return read_world(path, package_model_paths=ros_package_model_paths())
+    return load_world(cfg.world, cfg.map_wall_height) if cfg.world else None
 
 
 def _apply_world_physics(cfg, world, params):
@@ -565,11 +522,8 @@ def _report(cfg, loaded, world=None):
     """Log the effective configuration once and write it back to the private parameters."""
     for key, value in cfgmod.as_params(cfg).items():
         rospy.set_param("~" + key, value)
-    accepted = [f"{key}={cfg_value}" for key, cfg_value in
-                (("physics", cfg.physics_engine if cfg.physics_engine not in ("", "ode", "bullet") else ""),)
-                if cfg_value]
-    if accepted:
-        rospy.logwarn("bullet_sim: accepted, not simulated (the engine is Bullet): " + ", ".join(accepted))
+    if cfg.physics_engine not in ("", "ode", "bullet"):
+        rospy.logwarn(f"bullet_sim: physics={cfg.physics_engine} accepted, not simulated (the engine is Bullet)")
     if world is not None:
         for text in world.warnings:
             rospy.logwarn(f"world {world.source}: {text}")

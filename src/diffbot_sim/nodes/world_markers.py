@@ -101,19 +101,15 @@ def robot_namespaces(robots):
 
 
 def _read_world(sim):
+    """The simulator's world, read from its ``~world`` parameter through the loader it uses itself."""
     import rospy
 
-    from .sim_node import resolve_world_path
+    from ..description import load_world
 
     name = rospy.get_param(sim + "/world", "") or rospy.get_param(sim + "/world_name", "")
     if not name:
         return None
-    path = resolve_world_path(name)
-    if path.endswith((".yaml", ".yml")):
-        from ..world_map import read_map
-        return read_map(path, float(rospy.get_param(sim + "/map_wall_height", 1.0)))
-    from ..world_sdf import read_world, ros_package_model_paths
-    return read_world(path, package_model_paths=ros_package_model_paths())
+    return load_world(name, float(rospy.get_param(sim + "/map_wall_height", 1.0)))
 
 
 def _wait(predicate, timeout, what):

@@ -22,6 +22,14 @@ def publisher(name, msg_class):
         return rospy.Publisher(name, msg_class, queue_size=None)
 
 
+def get_param(name, default):
+    """A parameter from the server, or ``default`` when it is absent or the server cannot be asked."""
+    try:
+        return rospy.get_param(name, default)
+    except (KeyError, rospy.ROSException):
+        return default
+
+
 def join(namespace, name):
     """Resolve ``name`` under a plugin namespace (None or "": the node's namespace, a relative name)."""
     if name.startswith("/") or not namespace:
@@ -126,16 +134,17 @@ class RobotContext:
         """Remove one endpoint now (a controller unloaded while the robot lives on)."""
         if handle in self.handles:
             self.handles.remove(handle)
-        _close(handle)
+        close_handle(handle)
 
     def close(self):
         """Remove every endpoint of this robot: its topics disappear from the master (delete_model)."""
         handles, self.handles = self.handles, []
         for handle in handles:
-            _close(handle)
+            close_handle(handle)
 
 
-def _close(handle):
+def close_handle(handle):
+    """Take a publisher or subscriber off the master (unregister), or shut a service down."""
     if isinstance(handle, rospy.Service):
         handle.shutdown("model deleted")
     else:

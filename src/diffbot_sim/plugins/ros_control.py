@@ -37,7 +37,7 @@ from ..config import _number, _string
 from ..errors import ConfigError, ModelError
 from ..kinematics import quaternion_from_yaw
 from ..model import tag_value
-from .base import Plugin, join, next_due
+from .base import Plugin, get_param, join, next_due
 from .joint_motors import effort_limit
 
 #: Controller update period [s] when the plugin gives no ``controlPeriod``. Gazebo runs controllers at
@@ -99,7 +99,7 @@ class RosControl(Plugin):
         self.interfaces = {t.joint: t.interface for t in model.transmissions}
         self.commands = {}  # joint -> latest command from a controller
         self.pids = {}
-        gains = _param(join(ns, "gazebo_ros_control/pid_gains"), {})
+        gains = get_param(join(ns, "gazebo_ros_control/pid_gains"), {})
         for joint, values in (gains.items() if isinstance(gains, dict) else ()):
             if joint in self.interfaces and isinstance(values, dict):
                 try:
@@ -120,7 +120,6 @@ class RosControl(Plugin):
         self.loaded = {}  # controller name (relative to ns) -> runner: loaded, running or stopped
         self.next_control = 0.0
         self.last_pid_time = None
-        self.now = 0.0  # sim time of the last update: a controller started between steps starts at it
 
     def _check_pid_stability(self, ns):
         """Keep the explicit PID only where its discrete loop is stable at our step.
@@ -194,7 +193,6 @@ class RosControl(Plugin):
         robot.set_efforts([self.index[j] for j in names], efforts)
 
     def after_step(self, now, stamp, transforms):
-        self.now = now
         if now + 1e-9 < self.next_control:
             return
         self.next_control = next_due(self.next_control, self.period, now)
@@ -222,30 +220,31 @@ class RosControl(Plugin):
 
     def load(self, name):
         """LoadController: build ``name`` from ``<ns>/<name>`` on the parameter server, stopped."""
-        params = _param(self.full_name(name), None)
+        params = get_param(self.full_name(name), None)
         switching.check_load(name, self.loaded, params, KNOWN_TYPES)
         runner = make_runner(self.ctx, self, self.full_name(name), params)
         self.loaded[name] = runner
         return runner
 
+    def _running(self):
+        return [name for name, runner in self.loaded.items() if runner in self.controllers]
+
     def switch(self, start, stop, strictness):
         """SwitchController: stop, then start (controller_manager's rules, :mod:`diffbot_sim.switching`)."""
-        running = [n for n, r in self.loaded.items() if r in self.controllers]
         claims = {n: r.joints() for n, r in self.loaded.items()}
-        to_stop, to_start = switching.plan_switch(self.loaded, running, claims, start, stop, strictness)
+        to_stop, to_start = switching.plan_switch(self.loaded, self._running(), claims, start, stop, strictness)
         for name in to_stop:
             runner = self.loaded[name]
             self.controllers.remove(runner)
             runner.stop()
         for name in to_start:
             runner = self.loaded[name]
-            runner.start(self.now)
+            runner.start(self.ctx.sim.sim_time)
             self.controllers.append(runner)
 
     def unload(self, name):
         """UnloadController: a stopped controller goes, with its topics."""
-        running = [n for n, r in self.loaded.items() if r in self.controllers]
-        switching.check_unload(name, self.loaded, running)
+        switching.check_unload(name, self.loaded, self._running())
         runner = self.loaded.pop(name)
         for handle in runner.handles():
             self.ctx.release(handle)
@@ -468,17 +467,10 @@ class JointCommandRunner:
         return {f"{self.name}/command": self.sub.resolved_name}
 
 
-def _param(name, default):
-    try:
-        return rospy.get_param(name, default)
-    except (KeyError, rospy.ROSException):
-        return default
-
-
 def find_controllers(ns):
     """{controller namespace: its parameter dict} of every controller under ``ns`` on the parameter server,
     else anywhere on it (:func:`diffbot_sim.controllers.find_controllers`)."""
-    return controllers.find_controllers(_param("/", {}), ns or "/")
+    return controllers.find_controllers(get_param("/", {}), ns or "/")
 
 
 def create(ctx, element, path, params):
