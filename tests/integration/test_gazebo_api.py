@@ -244,6 +244,17 @@ class GazeboApiTest(unittest.TestCase):
         self.assertAlmostEqual(physics.time_step, 1.0 / 240.0, places=9)
         self.assertFalse(physics.pause)
         self.assertAlmostEqual(physics.gravity.z, -9.8, delta=0.02)
+        set_physics = proxy("set_physics_properties", gsrv.SetPhysicsProperties)
+        request = gsrv.SetPhysicsPropertiesRequest(time_step=physics.time_step, max_update_rate=physics.max_update_rate,
+                                                    gravity=Vector3(0.0, 0.0, -5.0), ode_config=physics.ode_config)
+        self.assertTrue(set_physics(request).success)
+        self.assertAlmostEqual(proxy("get_physics_properties", gsrv.GetPhysicsProperties)().gravity.z, -5.0)
+        request.gravity, request.time_step = physics.gravity, 0.001
+        refused = set_physics(request)
+        self.assertFalse(refused.success)
+        self.assertIn("time_step", refused.status_message)
+        request.time_step = physics.time_step
+        self.assertTrue(set_physics(request).success)
         rospy.ServiceProxy(f"{GZ}/pause_physics", Empty)()
         self.assertTrue(proxy("get_physics_properties", gsrv.GetPhysicsProperties)().pause)
         t0 = self.world().sim_time

@@ -59,6 +59,10 @@ class GazeboWayTest(unittest.TestCase):
                     states.get("joint_state_controller") == "running" and states
             states = wait(running, 60.0, f"{ns} controllers running (spawner)")
             self.assertEqual(len(states), 2)
+            claimed = {c.name: [(r.hardware_interface, list(r.resources)) for r in c.claimed_resources]
+                       for c in listing().controller}
+            self.assertEqual(claimed["joint_state_controller"], [("hardware_interface::JointStateInterface", [])])
+            self.assertEqual(claimed["mobile_base_controller"][0][0], "hardware_interface::VelocityJointInterface")
             joints = Latest(f"{ns}/joint_states", JointState)
             msg = wait(joints.get, 10.0, f"{ns}/joint_states")
             self.assertIn("front_left_wheel_joint", msg.name)
