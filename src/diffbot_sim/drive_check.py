@@ -1,13 +1,19 @@
-"""Judging a drive test: straight at 0.2 m/s for 4 s, then in place at 0.5 rad/s for 4 s (pure).
+"""Judging a drive test by the body: at rest first, then straight at 0.2 m/s for 4 s and in place at
+0.5 rad/s for 4 s (pure).
 
 The fixture-robot rostests (tests/integration/test_real_robot.py) and ``robot_check`` drive a robot the same
-way and must agree on what "it drives" means, so the measuring and the tolerances live here once. Poses are
-plain ``(x, y, yaw)`` tuples (m, m, rad), taken from the robot's own odometry and from the physics ground
-truth at the start and at the end of a motion; nothing here knows ROS messages.
+way and must agree on what "it drives" means, so the measuring and the tolerances live here once. The body is
+judged on the physics ground truth: before driving it rests upright at the height its geometry rests at on
+flat ground (:func:`rest`), while driving it stays there (:func:`ride`), and it moves and turns as commanded
+(:func:`straight`, :func:`turn`). The robot's own odometry is a second, separate claim, checked against the
+command too: a ros_control robot's odometry integrates its wheel encoders and reads a perfect drive while the
+body flies, sinks or slides. Motion poses are plain ``(x, y, yaw)`` tuples (m, m, rad) at the start and at the
+end of a motion; body samples are :class:`BodySample` tuples; nothing here knows ROS messages.
 """
 import math
+import statistics
 from dataclasses import dataclass, field
-from typing import List
+from typing import List, NamedTuple, Optional
 
 SPEED = 0.2  # m/s, the straight run's command
 TURN = 0.5  # rad/s, the turn in place's command
@@ -16,11 +22,48 @@ COMMAND_RATE = 20.0  # Hz (sim time) at which the command is repeated
 DISTANCE_TOLERANCE = 0.15  # fraction of SPEED * SECONDS
 MAX_HEADING_CHANGE = 0.1  # rad, while driving straight
 TURN_TOLERANCE = 0.20  # fraction of TURN * SECONDS, on the robot's own odometry
+HEIGHT_TOLERANCE = 0.02  # m: the resting body vs. its geometry's rest height, and the body while driving
+MAX_TILT = 0.1  # rad (5.7 degrees) between the body's z axis and the world's, at rest and while driving
+REST_SPEED = 0.02  # m/s: the fastest the body's origin may move over a rest
+TRUTH_TURN_FRACTION = 0.5  # of TURN * SECONDS: the least the body itself must turn in place
+SKID_TURN_FRACTION = 0.25  # the same for a skid-steered body (more than one wheel a side: its wheels slide)
+MAX_TURN_DRIFT = 0.1  # m the body's origin may move while turning in place
+
+
+class BodySample(NamedTuple):
+    """The ground-truth pose of the robot's root link at sim time ``t``: position [m] and roll, pitch, yaw
+    [rad] (REP 103)."""
+
+    t: float
+    x: float
+    y: float
+    z: float
+    roll: float
+    pitch: float
+    yaw: float
+
+    @property
+    def tilt(self):
+        """Angle [rad] between the body's z axis and the world's (0 upright, pi upside down)."""
+        return math.acos(max(-1.0, min(1.0, math.cos(self.roll) * math.cos(self.pitch))))
 
 
 def yaw_from_quaternion(x, y, z, w):
     """Yaw [rad] of a unit quaternion (rotation about z, as REP 103 robots turn)."""
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def roll_pitch_from_quaternion(x, y, z, w):
+    """(roll, pitch) [rad] of a unit quaternion (fixed-axis x-y-z, as REP 103)."""
+    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
+    return roll, pitch
+
+
+def body_sample(t, position, quaternion):
+    """A :class:`BodySample` from a position (x, y, z) and a quaternion (x, y, z, w)."""
+    roll, pitch = roll_pitch_from_quaternion(*quaternion)
+    return BodySample(t, position[0], position[1], position[2], roll, pitch, yaw_from_quaternion(*quaternion))
 
 
 def wrap(angle):
@@ -55,7 +98,7 @@ class Turn:
     expected: float  # rad
     odom_yaw: float  # rad, signed
     truth_yaw: float  # rad, signed
-    moved: float  # m the ground truth moved while turning
+    moved: float  # m the point the body turns about (the middle of its drive wheels) moved while turning
     failures: List[str] = field(default_factory=list)
 
     @property
@@ -78,25 +121,119 @@ def straight(odom_start, odom_end, truth_start, truth_end, expected=SPEED * SECO
     return result
 
 
-def turn(odom_start, odom_end, truth_start, truth_end, expected=TURN * SECONDS, truth_fraction=None,
-         max_moved=None, odom_fraction=1.0 - TURN_TOLERANCE):
-    """Judge the turn in place: the odometry's yaw change within TURN_TOLERANCE of ``expected``.
+def skid_turn_drift(half_length, half_width, angle):
+    """How far [m] the middle of a skid-steered wheel set may move turning ``angle`` [rad] in place: with more
+    than one wheel a side, the wheels slide, and Coulomb friction puts the centre of rotation where the loads
+    balance, anywhere inside the wheel footprint (2 ``half_length`` by 2 ``half_width``, m): a body whose mass
+    sits off its centre turns about a point off its centre (measured: 8.5 cm to one side moved the middle
+    0.36 m in a 1.6 rad turn). The bound is the chord of the farthest such centre, never less than
+    MAX_TURN_DRIFT."""
+    radius = math.hypot(half_length, half_width)
+    return max(MAX_TURN_DRIFT, 2.0 * radius * math.sin(min(abs(angle), math.pi) / 2.0))
 
-    The ground truth is always measured; it is judged only when asked: ``truth_fraction`` (the body must turn
-    the commanded way by at least this fraction of ``expected``) and ``max_moved`` (m). A four-wheel robot
-    driven as a diff drive turns its body slower than its wheels say (its wheels slide sideways), which its
-    own odometry does not see, so callers choose how much of that they tolerate; an odometry that *is* the
-    world pose (gazebo_ros_skid_steer_drive) sees the slide, hence ``odom_fraction`` (the lower bound).
+
+def centre_of(pose, centre):
+    """Where the point ``centre`` (x, y) of the body frame is in the world when the body is at ``pose``."""
+    x, y, yaw = pose
+    c, s = math.cos(yaw), math.sin(yaw)
+    return x + c * centre[0] - s * centre[1], y + s * centre[0] + c * centre[1]
+
+
+def turn(odom_start, odom_end, truth_start, truth_end, expected=TURN * SECONDS, truth_fraction=TRUTH_TURN_FRACTION,
+         max_moved=MAX_TURN_DRIFT, odom_fraction=1.0 - TURN_TOLERANCE, centre=(0.0, 0.0)):
+    """Judge the turn in place: the ground truth turns the commanded way by at least ``truth_fraction`` of
+    ``expected`` and at most TURN_TOLERANCE over it, and the point it turns about, ``centre`` (x, y) [m] in
+    the root link's frame (the middle of the drive wheels: a base_link ahead of or behind the axle circles
+    it), moves less than ``max_moved`` [m]; the odometry's yaw change is within ``odom_fraction``..1 +
+    TURN_TOLERANCE of ``expected``.
+
+    A four-wheel robot driven as a diff drive turns its body slower than its wheels say (its wheels slide
+    sideways), which its own odometry does not see, so callers may lower ``truth_fraction`` for it (skid
+    steering turns at about 0.75 of the command); an odometry that *is* the world pose
+    (gazebo_ros_skid_steer_drive) sees the slide, hence ``odom_fraction`` (the lower bound).
     """
     result = Turn(expected, wrap(odom_end[2] - odom_start[2]), wrap(truth_end[2] - truth_start[2]),
-                  _distance(truth_start, truth_end))
-    low, high = odom_fraction * expected, (1.0 + TURN_TOLERANCE) * expected
+                  _distance(centre_of(truth_start, centre), centre_of(truth_end, centre)))
+    high = (1.0 + TURN_TOLERANCE) * expected
+    low = odom_fraction * expected
     if not low < result.odom_yaw < high:
         result.failures.append(f"odometry: turned {result.odom_yaw:.3f} rad, expected {low:.2f}..{high:.2f} rad")
-    if truth_fraction is not None and not result.truth_yaw > truth_fraction * expected:
-        result.failures.append(f"ground truth: turned {result.truth_yaw:.3f} rad, expected more than "
-                               f"{truth_fraction * expected:.2f} rad")
-    if max_moved is not None and not result.moved < max_moved:
+    if not truth_fraction * expected < result.truth_yaw < high:
+        result.failures.append(f"ground truth: turned {result.truth_yaw:.3f} rad, expected "
+                               f"{truth_fraction * expected:.2f}..{high:.2f} rad")
+    if not result.moved < max_moved:
         result.failures.append(f"ground truth: turning in place moved the robot {result.moved:.3f} m "
                                f"(limit {max_moved} m)")
+    return result
+
+
+@dataclass
+class Rest:
+    """The body before driving, judged on ground-truth samples over a span of rest; ``failures`` empty when
+    it rests upright where its geometry says it should."""
+
+    expected: Optional[float]  # m, the root link's height when the robot stands on flat ground (None: unknown)
+    height: float  # m, the median height of the root link over the samples
+    tilt: float  # rad, the largest tilt
+    spread: float  # m, highest minus lowest height (a bouncing or sinking body)
+    speed: float  # m/s, how fast the origin moved over the span, on average
+    failures: List[str] = field(default_factory=list)
+
+    @property
+    def passed(self):
+        return not self.failures
+
+
+def rest(samples, expected=None):
+    """Judge the body at rest (no command): upright (tilt below MAX_TILT), its height steady (within
+    HEIGHT_TOLERANCE over the span) and within HEIGHT_TOLERANCE of ``expected`` when given, and still (its
+    origin slower than REST_SPEED). A robot thrown into the air at spawn, sunk into the ground or lying on its
+    side fails here, before any motion is judged."""
+    if not samples:
+        return Rest(expected, math.nan, math.nan, math.nan, math.nan, ["ground truth: no samples at rest"])
+    heights = [s.z for s in samples]
+    first, last = samples[0], samples[-1]
+    span = last.t - first.t
+    travel = math.dist((first.x, first.y, first.z), (last.x, last.y, last.z))
+    result = Rest(expected, statistics.median(heights), max(s.tilt for s in samples), max(heights) - min(heights),
+                  travel / span if span > 0 else 0.0)
+    if not result.tilt < MAX_TILT:
+        result.failures.append(f"ground truth: tilted {result.tilt:.3f} rad at rest (limit {MAX_TILT} rad)")
+    if expected is not None and not abs(result.height - expected) < HEIGHT_TOLERANCE:
+        result.failures.append(f"ground truth: rests at height {result.height:.3f} m, its geometry rests at "
+                               f"{expected:.3f} m (tolerance {HEIGHT_TOLERANCE} m)")
+    if not result.spread < HEIGHT_TOLERANCE:
+        result.failures.append(f"ground truth: height varied {result.spread:.3f} m at rest "
+                               f"({min(heights):.3f}..{max(heights):.3f} m)")
+    if not result.speed < REST_SPEED:
+        result.failures.append(f"ground truth: moved {travel:.3f} m in {span:.2f} s at rest")
+    return result
+
+
+@dataclass
+class Ride:
+    """The body while driving: how far its height left the rest height and how far it tilted."""
+
+    height: float  # m, the rest height it is held to
+    low: float  # m, lowest height while driving
+    high: float  # m, highest
+    tilt: float  # rad, the largest tilt
+    failures: List[str] = field(default_factory=list)
+
+    @property
+    def passed(self):
+        return not self.failures
+
+
+def ride(samples, height, what="driving"):
+    """Judge the body during a motion: it stays within HEIGHT_TOLERANCE of ``height`` (its rest height: no
+    flying, no sinking) and upright (tilt below MAX_TILT)."""
+    if not samples:
+        return Ride(height, math.nan, math.nan, math.nan, [f"ground truth: no samples while {what}"])
+    result = Ride(height, min(s.z for s in samples), max(s.z for s in samples), max(s.tilt for s in samples))
+    if not (abs(result.low - height) < HEIGHT_TOLERANCE and abs(result.high - height) < HEIGHT_TOLERANCE):
+        result.failures.append(f"ground truth: height {result.low:.3f}..{result.high:.3f} m while {what}, rest "
+                               f"height {height:.3f} m (tolerance {HEIGHT_TOLERANCE} m)")
+    if not result.tilt < MAX_TILT:
+        result.failures.append(f"ground truth: tilted {result.tilt:.3f} rad while {what} (limit {MAX_TILT} rad)")
     return result

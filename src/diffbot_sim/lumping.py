@@ -11,9 +11,13 @@ without ``<inertial>`` counts as 1 kg. So we lump ourselves, before PyBullet see
   re-attached; its frame is remembered (``frames``) so sensors can still be mounted on it;
 * a fixed child whose collisions have a surface of their own stays a separate PyBullet link on a fixed
   joint (rigid in PyBullet's Featherstone multibody), so its shapes keep their friction;
-* a link without ``<inertial>`` adds no mass: lumped, it adds nothing; kept (on a movable joint), it gets
-  PLACEHOLDER_MASS so the joint stays well-conditioned; a root left without mass gets ROOT_PLACEHOLDER_MASS
-  (0 would make PyBullet treat the whole robot as static).
+* a link without ``<inertial>`` adds no mass: lumped, it adds nothing; kept for its surface on a fixed joint,
+  it gets mass 0 (Gazebo lumps it); kept on a movable joint, it gets PLACEHOLDER_MASS so the joint stays
+  well-conditioned; a root left without mass gets ROOT_PLACEHOLDER_MASS (0 would make PyBullet treat the
+  whole robot as static);
+* an inertia-less root (``base_footprint``, or a ``base_link`` whose mass sits in an ``inertial_link`` or a
+  ``chassis_link``) takes its fixed children like any link: Gazebo makes them one body. Kept apart, a 1e-6 kg
+  PyBullet base carried the robot's mass through fixed joints, and the wheels hung on that base.
 
 Measured with 10 fixed sensor links: lumping keeps PyBullet's step rate (no extra links), where loading
 them unmerged costs ~25 %.
@@ -215,12 +219,7 @@ def lump(urdf_text, root_link, surface):
             t = offset[name] @ origin_matrix(joint)
             carrier = body[name]
             has_collision = links[child].find("collision") is not None
-            # An inertia-less root (base_footprint) keeps its fixed children as links of their own: measured
-            # on the seed robot, putting the base's mass on PyBullet's root made turns in place slip 1.2 %
-            # (0.2 % this way, as with PyBullet's own loader).
-            massless_root = carrier == root_link and links[root_link].find("inertial") is None
-            if joint.get("type") == "fixed" and not massless_root and (not has_collision
-                                                                         or key(child) == key(carrier)):
+            if joint.get("type") == "fixed" and (not has_collision or key(child) == key(carrier)):
                 body[child], offset[child] = carrier, t
                 lumped.append(child)
             else:
@@ -249,6 +248,7 @@ def lump(urdf_text, root_link, surface):
             joint.find("parent").set("link", body[parent])
 
     placeholders = []
+    on_fixed_joint = {j.find("child").get("link") for j in joints if j.get("type") == "fixed"}
     for name, el in links.items():
         if name in lumped or name not in body:
             continue
@@ -260,7 +260,10 @@ def lump(urdf_text, root_link, surface):
             _write_inertial(el, combined)
         else:
             placeholders.append(name)
-            _placeholder(el, ROOT_PLACEHOLDER_MASS if name == root_link else PLACEHOLDER_MASS)
+            if name in on_fixed_joint:
+                _placeholder(el, 0.0)  # kept for its surface only: Gazebo lumps it, adding no mass
+            else:
+                _placeholder(el, ROOT_PLACEHOLDER_MASS if name == root_link else PLACEHOLDER_MASS)
 
     frames = {}
     for name in order:

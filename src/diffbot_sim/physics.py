@@ -18,6 +18,22 @@ GAZEBO_DEFAULT_MU = 1.0
 #: link that gives only one of the two.
 GAZEBO_DEFAULT_KP = 1e12
 GAZEBO_DEFAULT_KD = 1.0
+#: How fast [1/s] Bullet may push a robot being set down out of what it lands on: a penetration ``d`` is undone
+#: at most at ``LANDING_CORRECTION_RATE * d`` m/s (the contact ERP is this times the step). Gazebo caps each
+#: body's correcting velocity at its SDF ``<max_vel>`` (0.01 m/s by default), so what lands on a contact lands
+#: dead; Bullet has no such cap, and a Gazebo kp/kd taken as is (kp 1e7, kd 1 on published 4-wheel robots: an
+#: undamped spring) gives an ERP of ~1. Measured, dropped from 1 m such a robot rebounds 0.26 m at ERP 1.0,
+#: 0.13 m at 0.7, 0.017 m at 0.3 and 0.005 m at 0.2, landing dead within 0.1 s. The same damping kept on while
+#: driving makes a four-wheel robot's turn in place wander (its origin moved 0.04 m at ERP 1.0 and 0.7, up to
+#: 0.18 m at 0.2), so it is on only while the robot is set down (:meth:`World.lift_out`), until it rests.
+LANDING_CORRECTION_RATE = 0.2 * 240.0
+#: A robot being set down rests once it touches something and its base moves slower than these
+#: (m/s, rad/s) for LANDING_REST_TIME s; it gets its own contacts back then, or after LANDING_MAX_TIME s.
+LANDING_REST_SPEED = (0.05, 0.2)
+LANDING_REST_TIME = 0.1
+LANDING_MAX_TIME = 3.0
+#: Placement (spawn, teleport, reset) lifts a robot out of what it would sit in, within this many passes.
+DEPENETRATION_PASSES = 4
 #: Rays per rayTestBatch call. PyBullet's limit is MAX_RAY_INTERSECTION_BATCH_SIZE_STREAMING (16 x 1024 on
 #: Linux); at exactly 16384 it returns 16383 results for list input and none for numpy input (bullet3 #4215,
 #: measured here: sensors.md section 6.1), and above it raises. 16383 works both ways.
@@ -90,6 +106,8 @@ class World:
         self.robots = []
         self.world_bodies = []  # (PyBullet id, world.Body)
         self.laser_retro = {}  # (PyBullet body, link index) -> Gazebo laser_retro, for hits that have one
+        self.landing_erp = min(1.0, LANDING_CORRECTION_RATE * time_step)
+        self.landing = {}  # Robot -> [steps it has rested, steps left] while it is set down (lift_out)
         self._setup()
 
     def _setup(self):
@@ -123,9 +141,11 @@ class World:
             body = pybullet.loadURDF(path, position, orientation, flags=flags, physicsClientId=self.client)
         if body < 0:
             raise ModelError("PyBullet could not load the model", model.source)
-        robot = Robot(self.client, body, model, position, orientation, prepared.frames)
+        robot = Robot(self.client, body, model, position, orientation, prepared.frames, self.time_step,
+                      self.landing_erp)
         robot.gravity = self.gravity
         self.robots.append(robot)
+        self.lift_out(robot)
         self.laser_retro.update(robot.laser_retro())
         return robot
 
@@ -231,6 +251,37 @@ class World:
         inv = pybullet.invertTransform(inertial_pose[0], inertial_pose[1])
         return pybullet.multiplyTransforms(com[0], com[1], inv[0], inv[1])
 
+    def lift_out(self, robot):
+        """Set ``robot`` down where it was placed: lift it out of whatever it was placed into (the ground, a
+        world body, another robot) so that its deepest collision point just touches, and damp its contacts
+        until it rests (LANDING_CORRECTION_RATE). Returns the lift [m].
+
+        Called wherever the robot is placed: spawn, reset, teleport. Gazebo pushes such a robot out at its
+        ``<max_vel>`` (0.01 m/s by default: 6 s for a robot spawned 6 cm deep) and ends where this starts;
+        Bullet would push it out in one step and throw it (measured: a robot 6 cm deep left at 14 m/s, one
+        13 cm deep flew 18 m up). Only contacts whose surface faces up count (a normal within 60 degrees of
+        +z): a robot is lifted off what it stands in, never pushed sideways out of a wall.
+        """
+        robot.damp_contacts(True)
+        self.landing[robot] = [0, round(LANDING_MAX_TIME / self.time_step)]
+        c = self.client
+        others = [b for b in range(pybullet.getNumBodies(physicsClientId=c))]
+        others = [pybullet.getBodyUniqueId(i, physicsClientId=c) for i in others]
+        others = [b for b in others if b != robot.body]
+        lifted = 0.0
+        for _ in range(DEPENETRATION_PASSES):
+            lift = 0.0
+            for other in others:
+                for point in pybullet.getClosestPoints(robot.body, other, 0.0, physicsClientId=c):
+                    depth, normal_z = -point[8], point[7][2]
+                    if depth > 1e-6 and normal_z > 0.5:
+                        lift = max(lift, depth / normal_z)
+            if lift <= 0.0:
+                break
+            robot.shift((0.0, 0.0, lift))
+            lifted += lift
+        return lifted
+
     def top_at(self, x, y, ignore=()):
         """Height [m] of the highest world surface at (x, y) (a ray from 100 m down), 0 when none."""
         hits = pybullet.rayTestBatch([(x, y, 100.0)], [(x, y, -100.0)], physicsClientId=self.client)
@@ -280,6 +331,23 @@ class World:
 
     def step(self):
         pybullet.stepSimulation(physicsClientId=self.client)
+        if self.landing:
+            self._watch_landings()
+
+    def _watch_landings(self):
+        """Give each robot being set down its own contacts back once it rests on something (or in time)."""
+        rest_steps = round(LANDING_REST_TIME / self.time_step)
+        for robot, state in list(self.landing.items()):
+            state[1] -= 1
+            linear, angular = pybullet.getBaseVelocity(robot.body, physicsClientId=self.client)
+            still = (math.sqrt(sum(v * v for v in linear)) < LANDING_REST_SPEED[0]
+                     and math.sqrt(sum(w * w for w in angular)) < LANDING_REST_SPEED[1])
+            if still and state[0] == 0 and not pybullet.getContactPoints(robot.body, physicsClientId=self.client):
+                still = False  # at rest in the air: it has not landed yet
+            state[0] = state[0] + 1 if still else 0
+            if state[0] >= rest_steps or state[1] <= 0:
+                robot.damp_contacts(False)
+                del self.landing[robot]
 
     def render(self, view_pose, width, height, hfov, near, far, renderer="tiny"):
         """A camera image from ``view_pose`` ((x, y, z), (qx, qy, qz, qw)) looking along that frame's +x, up
@@ -330,6 +398,7 @@ class World:
         """Delete a robot's body (delete_model)."""
         pybullet.removeBody(robot.body, physicsClientId=self.client)
         self.robots.remove(robot)
+        self.landing.pop(robot, None)
         for key in [k for k in self.laser_retro if k[0] == robot.body]:
             del self.laser_retro[key]
 
@@ -378,10 +447,12 @@ class World:
     def reset(self):
         """Put every robot back at its spawn pose and every world body at its start (a static one too: the
         world API may have moved it), at rest."""
-        for robot in self.robots:
-            robot.reset()
         for uid, body in self.world_bodies:
             self._place(uid, body.pose, body.inertial_pose)
+        for robot in self.robots:
+            robot.reset()
+        for robot in self.robots:
+            self.lift_out(robot)
 
     def close(self):
         if self.client is not None and pybullet.isConnected(self.client):
@@ -391,6 +462,19 @@ class World:
             with contextlib.suppress(OSError):
                 os.remove(path)
         self._files = []
+
+
+def contact_damping(kp, kd, time_step, max_erp):
+    """The damping [N·s/m] to give Bullet for a Gazebo contact of stiffness ``kp`` [N/m] and damping ``kd``.
+
+    Bullet (like ODE) turns them into ERP = dt·kp / (dt·kp + kd) and CFM = 1 / (dt·kp + kd): the stiffness is
+    kept whatever the damping, while the ERP, how much of a penetration is undone per step, grows to ~1 for
+    the stiff, lightly damped contacts real models give (kp 1e7, kd 1). Gazebo caps that correction at
+    ``<max_vel>``; Bullet cannot, so the damping is raised until the ERP is at most ``max_erp``: the same
+    spring, damped enough not to throw what lands on it (see LANDING_CORRECTION_RATE).
+    """
+    stiff = time_step * kp
+    return max(kd, 0.0, stiff * (1.0 / max_erp - 1.0)) if max_erp < 1.0 else max(kd, 0.0)
 
 
 def _point_velocity(linear, angular, r):
@@ -410,8 +494,9 @@ def _into_frame(orientation, *vectors):
 class Robot:
     """One loaded robot body: joint lookup, motors, state read-out. Created by ``World.load_robot``."""
 
-    def __init__(self, client, body, model, position, orientation, frames=None):
+    def __init__(self, client, body, model, position, orientation, frames=None, time_step=1 / 240, landing_erp=1.0):
         self.client = client
+        self.time_step, self.landing_erp = time_step, landing_erp
         self.frames = dict(frames or {})  # URDF link -> (PyBullet link carrying it, xyz, quaternion)
         self.gravity = -9.81  # set by World.load_robot
         self.body = body
@@ -435,17 +520,27 @@ class Robot:
     def _apply_surfaces(self):
         """Each PyBullet link gets the Gazebo surface of the URDF link it is (lumping only merged links of
         equal surface): friction from mu1/mu2 (PyBullet has one coefficient per link: the lower one),
-        Gazebo's default 1.0 when none is given; kp/kd as contact stiffness/damping."""
+        Gazebo's default 1.0 when none is given; kp/kd as contact stiffness/damping (:meth:`damp_contacts`)."""
+        self._contacts = {}  # PyBullet link index -> (kp, kd) of the links that give them
         for link, index in self._link_index.items():
             surface = self.model.surface(link)
             mus = [surface[k] for k in ("mu1", "mu2") if k in surface]
-            options = {"lateralFriction": min(mus) if mus else GAZEBO_DEFAULT_MU}
+            pybullet.changeDynamics(self.body, index, lateralFriction=min(mus) if mus else GAZEBO_DEFAULT_MU,
+                                    physicsClientId=self.client)
             if "kp" in surface or "kd" in surface:
                 kp = surface.get("kp", GAZEBO_DEFAULT_KP)
-                kd = surface.get("kd", GAZEBO_DEFAULT_KD)
                 if kp > 0:
-                    options.update(contactStiffness=kp, contactDamping=max(kd, 0.0))
-            pybullet.changeDynamics(self.body, index, physicsClientId=self.client, **options)
+                    self._contacts[index] = (kp, max(surface.get("kd", GAZEBO_DEFAULT_KD), 0.0))
+        self.damp_contacts(False)
+
+    def damp_contacts(self, landing):
+        """The links' kp/kd as contact stiffness/damping: as the model gives them, or (``landing``) with the
+        damping raised so that the contact ERP stays within ``landing_erp`` (:func:`contact_damping`): the
+        same springs, damped enough not to throw a robot being set down."""
+        for index, (kp, kd) in self._contacts.items():
+            damping = contact_damping(kp, kd, self.time_step, self.landing_erp) if landing else kd
+            pybullet.changeDynamics(self.body, index, contactStiffness=kp, contactDamping=damping,
+                                    physicsClientId=self.client)
 
     def laser_retro(self):
         """{(body, PyBullet link index): laserRetro} of links whose ``<gazebo reference>`` gives one. A
@@ -474,6 +569,11 @@ class Robot:
             state = pybullet.getLinkState(self.body, index, physicsClientId=self.client)
             base = (state[4], state[5])
         return pybullet.multiplyTransforms(base[0], base[1], xyz, quat)
+
+    def position_in_base(self, name):
+        """Where URDF link ``name``'s frame is in the root link's frame: (x, y, z) [m]."""
+        base = pybullet.invertTransform(*self.base_pose())
+        return tuple(pybullet.multiplyTransforms(*base, self.link_pose(name)[0], (0, 0, 0, 1))[0])
 
     def indices(self, names):
         return [self.joint_index[name] for name in names]
@@ -603,6 +703,12 @@ class Robot:
         pybullet.resetBasePositionAndOrientation(self.body, com[0], com[1], physicsClientId=self.client)
         v = _point_velocity(linear, angular, [com[0][i] - pose[0][i] for i in range(3)])
         pybullet.resetBaseVelocity(self.body, v, angular, physicsClientId=self.client)
+
+    def shift(self, offset):
+        """Move the whole robot by ``offset`` (x, y, z) [m], world axes, keeping its velocities."""
+        com, orientation = pybullet.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
+        moved = tuple(com[i] + offset[i] for i in range(3))
+        pybullet.resetBasePositionAndOrientation(self.body, moved, orientation, physicsClientId=self.client)
 
     def set_joint_positions(self, indices, positions):
         """Joint angles [rad] set at rest (set_model_configuration)."""

@@ -11,7 +11,7 @@ data and :func:`format_report` turns it into lines. Controller YAML files are pa
 import math
 import os
 from dataclasses import dataclass, field
-from typing import List, Optional
+from typing import List, Optional, Tuple
 
 from . import config as cfgmod
 from . import ddc, meshes
@@ -67,6 +67,16 @@ class Report:
     drives: List[Drive] = field(default_factory=list)
     items: List[Item] = field(default_factory=list)
     warnings: List[str] = field(default_factory=list)
+    rest_height: Optional[float] = None  # m: the root link's height when the robot stands on flat ground
+    #: m: the middle of the first drive's wheel centres in the root link's frame (x, y), which turns in place
+    wheel_centre: Tuple[float, float] = (0.0, 0.0)
+    footprint: Optional[Tuple[float, float]] = None  # m: those wheels' farthest |x|, |y| from that middle
+
+    @property
+    def skid(self):
+        """True when the first drive has more than one wheel a side (its wheels slide as it turns)."""
+        drive = self.drive
+        return drive is not None and (len(drive.left) > 1 or len(drive.right) > 1)
 
     @property
     def drive(self):
@@ -194,7 +204,9 @@ def build_report(path, model_args="", controller_files=(), known=None, resolve_p
 
     world = World(1.0 / 240.0)
     try:
-        loaded_mass = world.load_robot(text, model).total_mass()
+        loaded = world.load_robot(text, model)  # at the origin, lifted onto the ground it was placed into
+        loaded_mass, rest_height = loaded.total_mass(), loaded.base_pose()[0][2]
+        wheel_centre, footprint = _footprint(loaded, model, drives[0]) if drives else ((0.0, 0.0), None)
     finally:
         world.close()
     # model.warnings grows while loading (surface tags are read then), so it is taken last.
@@ -203,7 +215,19 @@ def build_report(path, model_args="", controller_files=(), known=None, resolve_p
         warnings.append("not simulated (ignored): " + "; ".join(found.unsupported))
     if not drives:
         warnings.append(NO_DRIVE)
-    return Report(source, model.name, model.total_mass(), loaded_mass, drives, items, _unique(warnings))
+    return Report(source, model.name, model.total_mass(), loaded_mass, drives, items, _unique(warnings),
+                  rest_height, wheel_centre, footprint)
+
+
+def _footprint(loaded, model, drive):
+    """``((x, y), (half length, half width))`` [m] of ``drive``'s wheel centres as loaded, in the root link's
+    frame: their middle and how far the farthest lies from it along x and y."""
+    points = [loaded.position_in_base(model.joints[joint].child) for joint in drive.left + drive.right
+              if joint in model.joints]
+    if not points:
+        return (0.0, 0.0), None
+    cx, cy = (sum(p[0] for p in points) / len(points), sum(p[1] for p in points) / len(points))
+    return (cx, cy), (max(abs(p[0] - cx) for p in points), max(abs(p[1] - cy) for p in points))
 
 
 def _no_package(package):
@@ -340,9 +364,27 @@ def _m(value):
     return "?" if value is None or not math.isfinite(value) else f"{value:.4g} m"
 
 
-def format_motions(straight, turn):
-    """Lines for the two judged motions (:mod:`diffbot_sim.drive_check` results); ``straight``/``turn`` may be
-    None when the motion could not be run."""
+def format_rest(rest):
+    """Lines for the body at rest before driving (a :class:`diffbot_sim.drive_check.Rest`)."""
+    expected = "" if rest.expected is None else f" (its geometry rests at {rest.expected:.3f} m)"
+    lines = [f"at rest (ground truth): height {rest.height:.3f} m{expected}, tilt {rest.tilt:.3f} rad, "
+             f"height varied {rest.spread:.3f} m: {'PASS' if rest.passed else 'FAIL'}"]
+    lines.extend(f"  {text}" for text in rest.failures)
+    return lines
+
+
+def _format_ride(ride):
+    """Lines for the body during a motion (a :class:`diffbot_sim.drive_check.Ride`)."""
+    lines = [f"  body (ground truth): height {ride.low:.3f}..{ride.high:.3f} m, tilt up to {ride.tilt:.3f} rad: "
+             f"{'PASS' if ride.passed else 'FAIL'}"]
+    lines.extend(f"    {text}" for text in ride.failures)
+    return lines
+
+
+def format_motions(straight, turn, straight_body=None, turn_body=None):
+    """Lines for the two judged motions (:mod:`diffbot_sim.drive_check` results) and, when given, the body
+    during each (:class:`~diffbot_sim.drive_check.Ride`); ``straight``/``turn`` may be None when the motion
+    could not be run."""
     lines = []
     if straight is not None:
         lines.append(f"straight 0.2 m/s x 4 s: odometry {straight.odom_distance:.3f} m, ground truth "
@@ -350,10 +392,14 @@ def format_motions(straight, turn):
                      f"{straight.odom_heading:.3f} / {straight.truth_heading:.3f} rad: "
                      f"{'PASS' if straight.passed else 'FAIL'}")
         lines.extend(f"  {text}" for text in straight.failures)
+        if straight_body is not None:
+            lines.extend(_format_ride(straight_body))
     if turn is not None:
         lines.append(f"turn 0.5 rad/s x 4 s: odometry {turn.odom_yaw:.3f} rad, ground truth {turn.truth_yaw:.3f} "
                      f"rad (command {turn.expected:.1f} rad), moved {turn.moved:.3f} m: "
                      f"{'PASS' if turn.passed else 'FAIL'}")
         lines.extend(f"  {text}" for text in turn.failures)
+        if turn_body is not None:
+            lines.extend(_format_ride(turn_body))
     return lines
 

@@ -1,17 +1,24 @@
 #!/usr/bin/env python3
-"""A fixture robot loaded unchanged drives as in Gazebo: straight at 0.2 m/s for 4 s (0.8 m, heading kept)
-and in place at 0.5 rad/s for 4 s, judged on its own odometry topic and on the physics ground truth.
+"""A fixture robot loaded unchanged drives as in Gazebo, judged by its body (the physics ground truth): spawned
+(paused, at ~spawn_z) it gains no height and lands and settles within 1 s of sim time, upright at the height its
+geometry rests at (~rest_height, computed by hand in the fixture's comment); then straight at 0.2 m/s for 4 s
+(0.8 m, heading kept) and in place at 0.5 rad/s for 4 s, staying at that height and upright while it drives.
+Its own odometry topic is a second, separate claim, judged against the command too.
 
-Private parameters: ~cmd_topic, ~odom_topic (the robot's own), ~urdf_mass (kg, the URDF's sum, computed by
-hand in the fixture's comment), ~skid (bool, default false): a four-wheel robot driven as a diff drive
-turns its body slower than its wheels say (its wheels slide sideways; real YAMLs carry a
-wheel_separation_multiplier for it), so in the turn its ground truth need only turn the right way by a
-quarter of the command and stay within 0.2 m, while its own odometry must still read the commanded turn;
-~odom_is_truth (bool, default false): the drive's odometry is the world pose (gazebo_ros_skid_steer_drive),
-so in the turn it is held to the ground truth's bounds; ~holonomic (bool, default false): also 0.2 m/s
-sideways (linear.y) for 4 s: 0.8 m to the robot's left, heading kept; ~imu_topic (optional): the base IMU
-a drive plugin publishes reads +9.81 m/s^2 on z and no yaw rate at rest (REP 145). Callbacks only record; waits poll with deadlines; times are sim time.
-The straight run and the turn are measured and judged by diffbot_sim.drive_check, shared with `robot_check`.
+Private parameters: ~cmd_topic, ~odom_topic (the robot's own), ~urdf_mass (kg, the URDF's sum), ~rest_height (m,
+the root link's height when standing on flat ground; default 0), ~spawn_z (m, where the launch file puts it;
+default 0), ~skid (bool, default false): a four-wheel robot driven as a diff drive turns its body slower than its
+wheels say (its wheels slide sideways; real YAMLs carry a wheel_separation_multiplier for it), so in the turn
+its ground truth need only turn the right way by a quarter of the command, while its own odometry must still
+read the commanded turn; ~wheel_centre ([x, y] in the root link's frame, m; default the origin): the middle of
+the drive wheels, which is what turns in place; ~footprint ([half length, half width] of a skid-steered wheel set, m): its body may turn
+about any point inside it (drive_check.skid_turn_drift), else its origin must stay within 0.1 m; ~odom_is_truth (bool, default false): the drive's odometry is the
+world pose (gazebo_ros_skid_steer_drive), so in the turn it is held to the ground truth's bounds; ~holonomic
+(bool, default false): also 0.2 m/s sideways (linear.y) for 4 s: 0.8 m to the robot's left, heading kept;
+~imu_topic (optional): the base IMU a drive plugin publishes reads +9.81 m/s^2 on z and no yaw rate at rest
+(REP 145). The launch file starts bullet_sim paused; this node unpauses it once it listens.
+Callbacks only record; waits poll with deadlines; times are sim time. The motions and the body are judged by
+diffbot_sim.drive_check, shared with `robot_check`.
 """
 import math
 import sys
@@ -24,6 +31,7 @@ import rostest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu
+from std_srvs.srv import Empty
 
 from diffbot_sim import drive_check
 from diffbot_sim.drive_check import SECONDS, SPEED, TURN, wrap
@@ -43,18 +51,30 @@ def pose_of(msg):
 
 
 class Latest:
-    def __init__(self):
+    """The newest message, how many came, and (``keep``) every message as a drive_check.BodySample."""
+
+    def __init__(self, keep=False):
         self.lock = threading.Lock()
         self.msg = None
         self.count = 0
+        self.samples = [] if keep else None
 
     def __call__(self, msg):
         with self.lock:
             self.msg, self.count = msg, self.count + 1
+            if self.samples is not None:
+                p, q = msg.pose.pose.position, msg.pose.pose.orientation
+                self.samples.append(drive_check.body_sample(msg.header.stamp.to_sec(), (p.x, p.y, p.z),
+                                                            (q.x, q.y, q.z, q.w)))
 
     def get(self):
         with self.lock:
             return self.msg
+
+    def between(self, start, end):
+        """The body samples stamped in [start, end] (sim time)."""
+        with self.lock:
+            return [s for s in self.samples if start <= s.t <= end]
 
 
 class RealRobotTest(unittest.TestCase):
@@ -63,9 +83,10 @@ class RealRobotTest(unittest.TestCase):
         rospy.init_node("test_real_robot")
         cls.cmd_topic = rospy.get_param("~cmd_topic")
         cls.odom = Latest()
-        cls.truth = Latest()
+        cls.truth = Latest(keep=True)
+        cls.truth_sub = rospy.Subscriber(SIM + "/ground_truth", Odometry, cls.truth, queue_size=100)
         cls.subs = [rospy.Subscriber(rospy.get_param("~odom_topic"), Odometry, cls.odom, queue_size=1),
-                    rospy.Subscriber(SIM + "/ground_truth", Odometry, cls.truth, queue_size=1)]
+                    cls.truth_sub]
         cls.pub = rospy.Publisher(cls.cmd_topic, Twist, queue_size=1)
         cls.imu = Latest()
         if rospy.has_param("~imu_topic"):
@@ -79,7 +100,8 @@ class RealRobotTest(unittest.TestCase):
             time.sleep(0.005)
 
     def drive(self, linear, angular, seconds, lateral=0.0):
-        """Command (linear, angular) at 20 Hz of sim time for ``seconds``; returns (odom, truth) at start and end."""
+        """Command (linear, angular) at 20 Hz of sim time for ``seconds``; returns (odom, truth) at start and
+        end, and the body samples in between."""
         start = (self.odom.get(), self.truth.get())
         end_time = rospy.get_time() + seconds
         msg = Twist()
@@ -89,7 +111,32 @@ class RealRobotTest(unittest.TestCase):
             rospy.sleep(0.05)
         end = (self.odom.get(), self.truth.get())
         self.pub.publish(Twist())
-        return start, end
+        return start, end, self.truth.between(start[1].header.stamp.to_sec(), end[1].header.stamp.to_sec())
+
+    def assert_ride(self, body, height, what):
+        ride = drive_check.ride(body, height, what)
+        rospy.loginfo(f"FIGURE body while {what}: height {ride.low:.4f}..{ride.high:.4f} m, tilt {ride.tilt:.4f} rad")
+        self.assertTrue(ride.passed, "; ".join(ride.failures))
+
+    def spawn_and_settle(self):
+        """Unpause the world the launch file started paused; the body must gain no height and be at rest,
+        upright at its geometry's height, from 1 s of sim time on (Gazebo lands a robot placed in the air)."""
+        self.wait(lambda: self.truth_sub.get_num_connections() > 0, 30.0, "the ground truth publisher")
+        rospy.wait_for_service(SIM + "/unpause_physics", timeout=30.0)
+        rospy.ServiceProxy(SIM + "/unpause_physics", Empty)()
+        self.wait(lambda: self.truth.between(2.0, 1e9), 60.0, "2 s of sim time of ground truth")
+        rest_height = rospy.get_param("~rest_height", 0.0)
+        spawn_z = rospy.get_param("~spawn_z", 0.0)
+        landing = self.truth.between(0.0, 2.0)
+        highest = max(s.z for s in landing)
+        rospy.loginfo(f"FIGURE spawn at z {spawn_z}: highest {highest:.4f} m")
+        self.assertLess(highest, max(spawn_z, rest_height) + drive_check.HEIGHT_TOLERANCE,
+                        f"the body rose to {highest:.3f} m after a spawn at z {spawn_z} (rest height {rest_height})")
+        rest = drive_check.rest(self.truth.between(1.0, 2.0), rest_height)
+        rospy.loginfo(f"FIGURE at rest from 1 s: height {rest.height:.4f} m (geometry {rest_height} m), "
+                      f"tilt {rest.tilt:.4f} rad, varied {rest.spread:.4f} m")
+        self.assertTrue(rest.passed, "; ".join(rest.failures))
+        return rest.height
 
     def stop(self, seconds=1.5):
         end_time = rospy.get_time() + seconds
@@ -98,6 +145,7 @@ class RealRobotTest(unittest.TestCase):
             rospy.sleep(0.05)
 
     def test_drives_straight_and_turns_in_place(self):
+        height = self.spawn_and_settle()
         self.wait(lambda: self.odom.get() is not None and self.truth.get() is not None, 60.0,
                   "the robot's odometry and the ground truth")
         self.wait(lambda: self.pub.get_num_connections() > 0, 30.0, f"a subscriber on {self.cmd_topic}")
@@ -105,7 +153,6 @@ class RealRobotTest(unittest.TestCase):
         self.assertAlmostEqual(rospy.get_param(SIM + "/urdf_mass"), urdf_mass, delta=1e-6)
         self.assertAlmostEqual(rospy.get_param(SIM + "/loaded_mass"), urdf_mass, delta=1e-3,
                                msg="loaded mass differs from the URDF's")
-        self.stop(1.0)  # settle after the drop onto the ground
         if rospy.has_param("~imu_topic"):
             self.wait(lambda: self.imu.count >= 3, 30.0, "the IMU")
             self.stop(0.5)
@@ -116,8 +163,9 @@ class RealRobotTest(unittest.TestCase):
             self.assertLess(abs(a.x) + abs(a.y), 0.1)
             self.assertLess(abs(w.z), 0.01)
 
-        (o0, t0), (o1, t1) = self.drive(SPEED, 0.0, SECONDS)
+        (o0, t0), (o1, t1), body = self.drive(SPEED, 0.0, SECONDS)
         self.stop()
+        self.assert_ride(body, height, "driving straight")
         straight = drive_check.straight(pose_of(o0), pose_of(o1), pose_of(t0), pose_of(t1))
         for name, distance, heading in (("odometry", straight.odom_distance, straight.odom_heading),
                                         ("ground truth", straight.truth_distance, straight.truth_heading)):
@@ -125,8 +173,9 @@ class RealRobotTest(unittest.TestCase):
         self.assertTrue(straight.passed, "; ".join(straight.failures))
 
         if rospy.get_param("~holonomic", False):
-            (o0, t0), (o1, t1) = self.drive(0.0, 0.0, SECONDS, lateral=SPEED)
+            (o0, t0), (o1, t1), body = self.drive(0.0, 0.0, SECONDS, lateral=SPEED)
             self.stop()
+            self.assert_ride(body, height, "driving sideways")
             for name, a, b in (("odometry", o0, o1), ("ground truth", t0, t1)):
                 p0, p1, yaw = a.pose.pose.position, b.pose.pose.position, yaw_of(a)
                 dx, dy = p1.x - p0.x, p1.y - p0.y
@@ -136,12 +185,18 @@ class RealRobotTest(unittest.TestCase):
                 self.assertLess(left, 1.15 * SPEED * SECONDS, f"{name}: moved {left:.3f} m left")
                 self.assertLess(abs(wrap(yaw_of(b) - yaw)), 0.1, f"{name}: heading changed")
 
-        (o0, t0), (o1, t1) = self.drive(0.0, TURN, SECONDS)
+        (o0, t0), (o1, t1), body = self.drive(0.0, TURN, SECONDS)
         self.stop()
+        self.assert_ride(body, height, "turning")
         skid = rospy.get_param("~skid", False)
         low = 0.25 if skid and rospy.get_param("~odom_is_truth", False) else 1.0 - drive_check.TURN_TOLERANCE
+        footprint = rospy.get_param("~footprint", None)  # [half length, half width] of a skid-steered wheel set
+        turned = wrap(yaw_of(t1) - yaw_of(t0))
+        drift = drive_check.skid_turn_drift(*footprint, turned) if footprint else drive_check.MAX_TURN_DRIFT
         turn = drive_check.turn(pose_of(o0), pose_of(o1), pose_of(t0), pose_of(t1), odom_fraction=low,
-                                truth_fraction=0.25 if skid else 0.5, max_moved=0.2 if skid else 0.1)
+                                truth_fraction=drive_check.SKID_TURN_FRACTION if skid
+                                else drive_check.TRUTH_TURN_FRACTION, max_moved=drift,
+                                centre=rospy.get_param("~wheel_centre", [0.0, 0.0]))
         rospy.loginfo(f"FIGURE turn: odometry {turn.odom_yaw:.3f} rad, truth {turn.truth_yaw:.3f} rad, "
                       f"moved {turn.moved:.3f} m")
         self.assertTrue(turn.passed, "; ".join(turn.failures))

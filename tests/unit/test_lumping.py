@@ -9,7 +9,7 @@ import numpy as np
 import pybullet
 import pytest
 
-from diffbot_sim import lumping, meshes
+from diffbot_sim import lumping, meshes, physics
 from diffbot_sim.description import load_file
 from diffbot_sim.model import parse_urdf
 from diffbot_sim.physics import World
@@ -203,13 +203,26 @@ def test_inertialess_links_add_no_mass_beyond_their_placeholders():
         + joint("imu_joint", "base_link", "imu_link", xyz="0.05 0 0.02")
         + joint("wheel_joint", "base_link", "wheel", kind="continuous", xyz="0 0.1 0"))
     out = lump_text(text)
-    assert out.lumped == ["imu_link"]
-    assert sorted(out.placeholders) == ["base_footprint", "wheel"]
+    assert out.lumped == ["base_link", "imu_link"]  # into the inertia-less root, which takes base_link's mass
+    assert out.placeholders == ["wheel"]
     links = links_of(out.text)
-    # 1 mg on the inertia-less root, 0.1 g on the inertia-less link of a movable joint; nothing for imu_link.
-    assert float(links["base_footprint"].find("inertial/mass").get("value")) == 1e-6
+    # 0.1 g on the inertia-less link of a movable joint; nothing for imu_link.
     assert float(links["wheel"].find("inertial/mass").get("value")) == 1e-4
-    assert total_written_mass(out.text) == pytest.approx(2.0 + 1e-6 + 1e-4, abs=1e-15)
+    assert total_written_mass(out.text) == pytest.approx(2.0 + 1e-4, abs=1e-15)
+
+
+def test_a_link_kept_for_its_own_surface_adds_no_mass():
+    # An inertia-less root whose only child on a fixed joint has a collision of another friction: kept as a
+    # link of its own (for the friction), with no mass, as Gazebo (which lumps it) gives it none.
+    text = robot(
+        f'<link name="base_link"><collision><geometry><box size="0.2 0.2 0.05"/></geometry></collision>'
+        f'{inertial(2.0)}</link>'
+        '<link name="plate"><collision><geometry><box size="0.2 0.2 0.01"/></geometry></collision></link>'
+        + joint("plate_joint", "base_link", "plate", xyz="0 0 0.05")
+        + '<gazebo reference="plate"><mu1>0.3</mu1></gazebo>')
+    out = lump_text(text)
+    assert out.lumped == [] and out.placeholders == ["plate"]
+    assert total_written_mass(out.text) == pytest.approx(2.0, abs=1e-15)
 
 
 def test_root_with_mass_gets_no_placeholder():
@@ -220,17 +233,21 @@ def test_root_with_mass_gets_no_placeholder():
     assert total_written_mass(out.text) == pytest.approx(2.0, abs=1e-15)
 
 
-def test_inertialess_root_keeps_its_fixed_children_as_links():
+def test_an_inertialess_root_takes_its_fixed_children_as_gazebo_lumps_them():
+    # The published traits: base_footprint or base_link without <inertial>, the mass in a child on a fixed
+    # joint (base_link, chassis_link, inertial_link). Gazebo makes them one body; so do we (kept as links of
+    # their own, a 1e-6 kg root carried the robot through Featherstone joints).
     text = robot('<link name="base_footprint"/>'
                  f'<link name="base_link">{inertial(2.0)}</link><link name="laser">{inertial(0.1)}</link>'
                  + joint("base_joint", "base_footprint", "base_link", xyz="0 0 0.05")
                  + joint("laser_joint", "base_link", "laser", xyz="0 0 0.1"))
     out = lump_text(text)
-    assert out.lumped == ["laser"]  # the root's child stays; its own fixed child is lumped into it
-    assert set(links_of(out.text)) == {"base_footprint", "base_link"}
-    assert joints_of(out.text)["base_joint"].get("type") == "fixed"
-    assert out.frames["base_link"][0] == "base_link"
-    assert out.frames["laser"][0] == "base_link"
+    assert out.lumped == ["base_link", "laser"]
+    assert set(links_of(out.text)) == {"base_footprint"}
+    assert links_of(out.text)["base_footprint"].find("inertial/mass").get("value") == "2.1"
+    assert out.frames["base_link"][0] == out.frames["laser"][0] == "base_footprint"
+    assert out.frames["base_link"][1] == pytest.approx((0.0, 0.0, 0.05))
+    assert out.frames["laser"][1] == pytest.approx((0.0, 0.0, 0.15))
 
 
 def test_untouched_link_keeps_its_inertial_as_written():
@@ -321,24 +338,53 @@ def test_loaded_mass_equals_the_urdf_sum(world, tmp_path, path):
 def test_fixed_caster_keeps_its_own_friction_and_links_without_mu_get_gazebos_default(world, tmp_path):
     _, loaded = load(world, FIXED_CASTER, tmp_path)
     assert "caster_link" in link_indices(loaded) and "imu_link" not in link_indices(loaded)
+    assert "base_link" not in link_indices(loaded)  # lumped into the inertia-less base_footprint
     assert dynamics(loaded, "caster_link")[1] == pytest.approx(0.1)  # text form
     assert dynamics(loaded, "left_wheel_link")[1] == pytest.approx(0.1)  # attribute form
     assert dynamics(loaded, "right_wheel_link")[1] == pytest.approx(0.1)
-    assert dynamics(loaded, "base_link")[1] == pytest.approx(1.0)
     assert dynamics(loaded, "base_footprint")[1] == pytest.approx(1.0)
+
+
+def erp(stiffness, damping, dt=1 / 240):
+    """The contact ERP Bullet derives from a link's contact stiffness and damping."""
+    return dt * stiffness / (dt * stiffness + damping)
+
+
+def set_down(world, robot, seconds=1.0):
+    """Step until ``robot`` rests and has its own contacts back (World.lift_out damps them while it lands)."""
+    for _ in range(round(seconds / world.time_step)):
+        world.step()
+    assert robot not in world.landing
 
 
 def test_kp_kd_become_contact_stiffness_and_damping(world, tmp_path):
     _, loaded = load(world, FIXED_CASTER, tmp_path)
+    set_down(world, loaded)
     info = dynamics(loaded, "left_wheel_link")
     assert (info[9], info[8]) == pytest.approx((500000.0, 10.0))  # contactStiffness, contactDamping
     assert dynamics(loaded, "caster_link")[9] != pytest.approx(500000.0)
+
+
+def test_while_set_down_the_damping_keeps_the_erp_within_0_2(world, tmp_path):
+    _, loaded = load(world, FIXED_CASTER, tmp_path)
+    info = dynamics(loaded, "left_wheel_link")  # kp 5e5, kd 10: ERP 0.995 as given
+    assert info[9] == pytest.approx(500000.0)  # contactStiffness kept
+    assert info[8] == pytest.approx(500000.0 / 240 * (1 / 0.2 - 1))  # contactDamping raised
+    assert erp(info[9], info[8]) == pytest.approx(0.2)
+
+
+def test_contact_damping_raises_only_what_exceeds_the_erp():
+    # kp 100, kd 50 at 240 Hz: ERP 0.008, below the cap: nothing to raise.
+    assert physics.contact_damping(100.0, 50.0, 1 / 240, 0.2) == 50.0
+    assert physics.contact_damping(1e7, 1.0, 1 / 240, 0.2) == pytest.approx(1e7 / 240 * 4)
+    assert physics.contact_damping(1e7, 1.0, 1 / 240, 1.0) == 1.0
 
 
 @pytest.mark.parametrize("tags, expected", [("<kp>2e5</kp>", (2e5, 1.0)), ("<kd>3</kd>", (1e12, 3.0))])
 def test_a_missing_kp_or_kd_takes_gazebos_default(world, make_urdf, tags, expected):
     text = make_urdf(gazebo=f'<gazebo reference="left_wheel_link">{tags}</gazebo>')
     loaded = world.load_robot(text, parse_urdf(text, "test.urdf"))
+    set_down(world, loaded)
     info = dynamics(loaded, "left_wheel_link")
     assert (info[9], info[8]) == pytest.approx(expected)
 

@@ -468,6 +468,10 @@ def world():
     from diffbot_sim.physics import World
 
     made = World(1.0 / 240.0)
+    # No ground: these tests measure shapes where they are loaded, and a robot placed into the ground is
+    # lifted out of it.
+    pybullet.removeBody(made.plane, physicsClientId=made.client)
+    made.plane = None
     yield made
     made.close()
 

@@ -137,17 +137,17 @@ def test_pybullet_loads_it_with_the_urdf_mass_and_the_mesh_box(loaded):
         robot = world.load_robot(loaded.text, loaded.model)
         assert robot.total_mass() == pytest.approx(URDF_MASS, abs=1e-5)
         assert set(robot.joint_index) == {"left_wheel_joint", "right_wheel_joint"}
-        index = {pybullet.getJointInfo(robot.body, i, physicsClientId=world.client)[12].decode(): i
-                 for i in range(pybullet.getNumJoints(robot.body, physicsClientId=world.client))}["base_link"]
+        index = robot.link_carrier("base_link")  # lumped into the inertia-less root, as Gazebo lumps it
         (shape,) = pybullet.getCollisionShapeData(robot.body, index, physicsClientId=world.client)
         assert shape[2] == pybullet.GEOM_MESH and shape[3] == pytest.approx((0.001, 0.001, 0.001))
         vertices, _ = meshes.read_obj(shape[4].decode())  # the cached .obj, in the STL's millimetres
         assert vertices.max(axis=0) - vertices.min(axis=0) == pytest.approx([200.0, 150.0, 40.0])
-        # The shape sits at base_link's origin, unturned: PyBullet stores it relative to the link's inertial
-        # frame (turned into the principal axes of base_link + the lumped laser), so compose the two.
+        # The shape sits at base_link's origin, unturned: PyBullet stores it relative to the carrier's inertial
+        # frame (turned into the principal axes of base_link + the lumped laser), so compose the two; base_link
+        # sits at its fixed offset in the carrier's frame.
         dyn = pybullet.getDynamicsInfo(robot.body, index, physicsClientId=world.client)
         position, orientation = pybullet.multiplyTransforms(dyn[3], dyn[4], shape[5], shape[6])
-        assert position == pytest.approx((0.0, 0.0, 0.0), abs=1e-6)
+        assert position == pytest.approx(robot.frames["base_link"][1], abs=1e-6)
         assert abs(orientation[3]) == pytest.approx(1.0, abs=1e-6)
     finally:
         world.close()

@@ -1,6 +1,7 @@
 """physics.py on PyBullet DIRECT: faithful mass, poses in the URDF link frame, REP 103 driving, passive
 casters, reset, independent worlds. Every test gets fresh worlds, closed by the fixture; runs are short."""
 import math
+import os
 import xml.etree.ElementTree as ET
 
 import pybullet
@@ -229,3 +230,68 @@ def test_controller_and_encoder_odometry_track_physics(seed):
     assert odom.x == pytest.approx(x, abs=0.02)
     assert odom.y == pytest.approx(y, abs=0.02)
     assert abs(angle_diff(odom.yaw, yaw)) < 0.05
+
+
+# --------------------------------------------------------------------------------- setting a robot down
+# tests/data/robots/inertial_link_4wd.urdf: an inertia-less base_link whose geometry rests at z 0.13228 (the
+# wheels, radius 0.1651, hang 0.03282 above base_link), stiff undamped wheel contacts (kp 1e7, kd 1).
+
+FOUR_WD = os.path.join(os.path.dirname(__file__), "..", "data", "robots", "inertial_link_4wd.urdf")
+REST_Z = 0.13228
+
+
+def heights(world, robot, seconds):
+    out = []
+    for _ in range(int(round(seconds / world.time_step))):
+        world.step()
+        out.append(robot.base_pose()[0][2])
+    return out
+
+
+@pytest.fixture
+def four_wd():
+    with open(FOUR_WD) as handle:
+        text = handle.read()
+    return text, parse_urdf(text, FOUR_WD)
+
+
+def test_a_robot_spawned_into_the_ground_is_set_on_it_and_stays(make_world, four_wd):
+    # Spawned at z 0, as its Gazebo launch file does: the wheels 0.132 m deep. Bullet alone threw such a robot
+    # 18 m up (each contact pushed it out in one step); Gazebo pushes it out at <max_vel> and ends resting.
+    world = make_world()
+    robot = world.load_robot(*four_wd, position=(0.0, 0.0, 0.0))
+    assert robot.base_pose()[0][2] == pytest.approx(REST_Z, abs=1e-4)
+    zs = heights(world, robot, 2.0)
+    assert max(zs) < REST_Z + 0.002 and min(zs) > REST_Z - 0.002
+
+
+@pytest.mark.parametrize("z", [1.0, 1.5])
+def test_a_robot_spawned_in_the_air_lands_and_settles_within_a_second(make_world, four_wd, z):
+    world = make_world()
+    robot = world.load_robot(*four_wd, position=(0.0, 0.0, z))
+    zs = heights(world, robot, 2.0)
+    after = zs[round(1.0 / world.time_step):]  # from 1 s of sim time on
+    assert max(after) - min(after) < 0.002 and abs(after[-1] - REST_Z) < 0.002
+    landed = next(i for i, h in enumerate(zs) if h < REST_Z + 0.01)
+    assert max(zs[landed:]) < REST_Z + 0.02  # no rebound (kp 1e7, kd 1 as given: 0.26 m from 1 m)
+    assert robot not in world.landing  # its own contacts back once at rest
+
+
+def test_a_robot_teleported_into_the_ground_or_reset_is_set_down_again(make_world, four_wd):
+    world = make_world()
+    robot = world.load_robot(*four_wd)
+    run(world, 0.5)
+    robot.set_base_motion(((1.0, 0.0, -0.05), (0, 0, 0, 1)), (0, 0, 0), (0, 0, 0))
+    assert world.lift_out(robot) == pytest.approx(REST_Z + 0.05, abs=1e-4)
+    assert max(heights(world, robot, 1.0)) < REST_Z + 0.002
+    world.reset()
+    assert robot.base_pose()[0] == pytest.approx((0.0, 0.0, REST_Z), abs=1e-4)
+
+
+def test_lifting_only_counts_what_the_robot_stands_in(make_world, seed_urdf, seed_model):
+    # Above the ground nothing is touched: the spawn height is kept, and the robot falls as in Gazebo.
+    world = make_world()
+    robot = world.load_robot(seed_urdf, seed_model, position=(0.0, 0.0, 0.3))
+    assert robot.base_pose()[0][2] == pytest.approx(0.3, abs=1e-6)
+    run(world, 0.1)
+    assert robot.base_pose()[0][2] < 0.3 - 0.5 * 9.81 * 0.09 ** 2

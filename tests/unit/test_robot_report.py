@@ -206,10 +206,60 @@ def test_turn_judged_on_odometry_across_the_wrap():
     # from 2.5 rad to -2.283 (= 2.5 + 1.5 - 2 pi): 1.5 rad turned through +-pi, 25 % short of 2.0: fails
     t = drive_check.turn((0, 0, 2.5), (0, 0, 2.5 + 1.5 - 2 * 3.141592653589793), (0, 0, 0), (0, 0, 0.1))
     assert t.odom_yaw == pytest.approx(1.5) and not t.passed
-    t = drive_check.turn((0, 0, 2.5), (0, 0, 2.5 + 1.9 - 2 * 3.141592653589793), (0, 0, 0), (0, 0, 0.1))
-    assert t.passed  # the ground truth is only judged when asked
-    t = drive_check.turn((0, 0, 0), (0, 0, 1.9), (0, 0, 0), (0.15, 0, 0.1), truth_fraction=0.5, max_moved=0.1)
+    t = drive_check.turn((0, 0, 2.5), (0, 0, 2.5 + 1.9 - 2 * 3.141592653589793), (0, 0, 0), (0, 0, 1.9))
+    assert t.passed
+
+
+def test_turn_judged_on_the_body_whatever_the_odometry_says():
+    # The encoders read a perfect turn; the body turned 0.1 rad and slid 0.15 m: both are failures.
+    t = drive_check.turn((0, 0, 0), (0, 0, 2.0), (0, 0, 0), (0.15, 0, 0.1))
     assert [f.split(":")[0] for f in t.failures] == ["ground truth", "ground truth"]
+    # A skid-steer body turning at 0.75 of the command passes when the caller allows it, not by default.
+    assert drive_check.turn((0, 0, 0), (0, 0, 2.0), (0, 0, 0), (0, 0, 1.5), truth_fraction=0.7).passed
+    assert drive_check.turn((0, 0, 0), (0, 0, 2.0), (0, 0, 0), (0, 0, 0.9)).failures[0].startswith("ground truth")
+    assert not drive_check.turn((0, 0, 0), (0, 0, 2.0), (0, 0, 0), (0, 0, 2.6)).passed  # spun too far
+
+
+def samples(heights, tilt=0.0, dt=0.1, x=0.0):
+    return [drive_check.BodySample(i * dt, x, 0.0, z, tilt, 0.0, 0.0) for i, z in enumerate(heights)]
+
+
+def test_a_body_resting_upright_at_its_height_passes():
+    r = drive_check.rest(samples([0.0635, 0.0636, 0.0635]), expected=0.0635)
+    assert r.passed and r.height == pytest.approx(0.0635, abs=1e-4) and r.tilt == 0.0
+
+
+@pytest.mark.parametrize("body, culprit", [
+    (samples([6.1, 6.0, 5.9]), "rests at height 6.000 m"),  # thrown into the air at spawn
+    (samples([-0.2, -0.21, -0.2]), "rests at height -0.200 m"),  # sunk into the ground
+    (samples([0.0635] * 3, tilt=1.5), "tilted 1.500 rad at rest"),  # on its side
+    (samples([0.06, 0.09, 0.06]), "height varied 0.030 m"),  # bouncing
+])
+def test_a_body_flying_sunk_tipped_or_bouncing_fails_at_rest(body, culprit):
+    r = drive_check.rest(body, expected=0.0635)
+    assert not r.passed and any(culprit in f for f in r.failures), r.failures
+
+
+def test_a_body_sliding_at_rest_fails():
+    body = [drive_check.BodySample(t, 0.1 * t, 0.0, 0.0635, 0.0, 0.0, 0.0) for t in (0.0, 0.5, 1.0)]
+    assert any("moved 0.100 m" in f for f in drive_check.rest(body, 0.0635).failures)
+
+
+def test_ride_holds_the_body_to_its_rest_height_and_upright():
+    assert drive_check.ride(samples([0.064, 0.070, 0.060]), 0.0635).passed
+    sinks = drive_check.ride(samples([0.06, -0.2]), 0.0635)
+    assert not sinks.passed and "height -0.200..0.060 m" in sinks.failures[0]
+    tips = drive_check.ride(samples([0.0635], tilt=0.3), 0.0635)
+    assert "tilted 0.300 rad while driving" in tips.failures[0]
+    assert not drive_check.ride([], 0.0635).passed
+
+
+def test_body_sample_from_a_quaternion():
+    import math
+    s = drive_check.body_sample(1.0, (1, 2, 3), (math.sin(0.25), 0, 0, math.cos(0.25)))  # roll 0.5
+    assert (s.roll, s.pitch, s.yaw) == pytest.approx((0.5, 0.0, 0.0)) and s.tilt == pytest.approx(0.5)
+    s = drive_check.body_sample(1.0, (1, 2, 3), (0, math.sin(0.15), 0, math.cos(0.15)))  # pitch 0.3
+    assert (s.roll, s.pitch) == pytest.approx((0.0, 0.3)) and s.tilt == pytest.approx(0.3)
 
 
 def test_yaw_from_quaternion():

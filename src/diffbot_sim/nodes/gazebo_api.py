@@ -85,6 +85,7 @@ class _Robot:
             raise RequestError(f"link '{self.name}::{link}' is not the model's canonical link "
                                f"'{self.model.root}': only a whole model can be moved here")
         self.robot.set_base_motion(pose, linear, angular)
+        self.runtime.ctx.sim.world.lift_out(self.robot)
 
     def body_of(self, link):
         return self.robot.body, self.robot.link_carrier(link)
@@ -496,6 +497,7 @@ class GazeboApi:
                 if not math.isfinite(position):
                     raise RequestError(f"SetModelConfiguration: joint '{joint}' position is {position}")
             robot.set_joint_positions(robot.indices(list(req.joint_names)), list(req.joint_positions))
+            entity.runtime.ctx.sim.world.lift_out(robot)
             return "SetModelConfiguration: success"
         return self._run(action, gsrv.SetModelConfigurationResponse())
 

@@ -325,21 +325,33 @@ def _message(line):
 # ----------------------------------------------------------------------------------------------- drive
 
 class _Latest:
-    """The newest message of a topic as an ``(x, y, yaw)`` pose (callbacks only store)."""
+    """The newest message of a topic as an ``(x, y, yaw)`` pose, and every message since ``start_span`` as
+    a :class:`diffbot_sim.drive_check.BodySample` (callbacks only store)."""
 
     def __init__(self):
         self.lock = threading.Lock()
         self.pose = None
+        self.span = []
 
     def __call__(self, msg):
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
-        pose = (p.x, p.y, drive_check.yaw_from_quaternion(q.x, q.y, q.z, q.w))
+        sample = drive_check.body_sample(msg.header.stamp.to_sec(), (p.x, p.y, p.z), (q.x, q.y, q.z, q.w))
         with self.lock:
-            self.pose = pose
+            self.pose = (sample.x, sample.y, sample.yaw)
+            self.span.append(sample)
 
     def get(self):
         with self.lock:
             return self.pose
+
+    def start_span(self):
+        with self.lock:
+            self.span = []
+
+    def take_span(self):
+        with self.lock:
+            span, self.span = self.span, []
+            return span
 
 
 def _wait(predicate, timeout, what, session):
@@ -382,31 +394,47 @@ def _drive(session, report):
     watchdog = threading.Thread(target=_watch, args=(session, time.monotonic() + DRIVE_TIMEOUT), daemon=True)
     watchdog.start()
     try:
+        _command(pub, 0.0, 0.0, SETTLE)  # a robot placed in the air lands (Gazebo's launch files say z 1.0)
+        truth.start_span()
         _command(pub, 0.0, 0.0, SETTLE)
+        rest = drive_check.rest(truth.take_span(), report.rest_height)
         start = (odom.get(), truth.get())
         _command(pub, drive_check.SPEED, 0.0, drive_check.SECONDS)
         end = (odom.get(), truth.get())
+        straight_body = drive_check.ride(truth.take_span(), rest.height, "driving straight")
         _command(pub, 0.0, 0.0, PAUSE)
         straight = drive_check.straight(start[0], end[0], start[1], end[1])
         start = (odom.get(), truth.get())
+        truth.start_span()
         _command(pub, 0.0, drive_check.TURN, drive_check.SECONDS)
         end = (odom.get(), truth.get())
+        turn_body = drive_check.ride(truth.take_span(), rest.height, "turning")
         _command(pub, 0.0, 0.0, PAUSE)
-        turn = drive_check.turn(start[0], end[0], start[1], end[1])
+        turned = drive_check.wrap(end[1][2] - start[1][2])
+        drift = drive_check.skid_turn_drift(*report.footprint, turned) if report.skid and report.footprint \
+            else drive_check.MAX_TURN_DRIFT
+        turn = drive_check.turn(start[0], end[0], start[1], end[1], max_moved=drift, centre=report.wheel_centre,
+                                truth_fraction=drive_check.SKID_TURN_FRACTION if report.skid
+                                else drive_check.TRUTH_TURN_FRACTION)
     except rospy.ROSInterruptException:
         raise SessionError(session.sim_failure() or f"the drive took longer than {DRIVE_TIMEOUT:g} s "
                            "of wall time (sim time stopped?)") from None
     finally:
         for sub in subs:
             sub.unregister()
-    for line in robot_report.format_motions(straight, turn):
+    for line in robot_report.format_rest(rest):
+        _say(line)
+    for line in robot_report.format_motions(straight, turn, straight_body, turn_body):
         _say(line)
     during = [w for w in session.sim_warnings() if w not in logged and w not in report.warnings]
     for text in during[:3]:
         _say(f"  bullet_sim warned while driving: {text}")
     if len(during) > 3:
         _say(f"  ... and {len(during) - 3} more")
-    if straight.passed and turn.passed:
+    if not rest.passed:
+        _say("result: FAIL: the robot does not rest upright on the ground before driving (ground truth)")
+        return 1
+    if straight.passed and turn.passed and straight_body.passed and turn_body.passed:
         _say("result: PASS: the robot drives")
         return 0
     _say("result: FAIL: the robot does not drive as commanded")

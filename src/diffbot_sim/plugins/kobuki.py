@@ -60,6 +60,7 @@ class Kobuki(Plugin):
         self.odom_frame, self.base_frame = ctx.frame("odom"), ctx.frame("base_footprint")
         self.wheel_cmd = (0.0, 0.0)
         self.cmd_time = None
+        self.holding = False  # the wheel motors have been given a target (they keep it between updates)
         self.x = self.y = self.yaw = 0.0
         self.last_time = None
         self._imu_velocity = None  # world velocity of the base frame at the last update (accelerometer)
@@ -118,10 +119,13 @@ class Kobuki(Plugin):
                 (linear, angular), self._pending = self._pending, None
             self.wheel_cmd = wheel_speeds(linear, angular, self.separation)
             self.cmd_time = now
-        elif self.cmd_time is None or now - self.cmd_time <= self.timeout:
-            return
-        else:
+        elif self.cmd_time is not None and now - self.cmd_time > self.timeout:
             self.wheel_cmd, self.cmd_time = (0.0, 0.0), None  # stale: stop, as the original does
+        elif self.holding:
+            return  # the motors keep their targets
+        # The original sets the wheel velocities with the torque limit on every update, from the first one: the
+        # wheels are held at 0 before any command (free wheels let a robot on frictionless casters roll away).
+        self.holding = True
         left, right = self.wheel_cmd
         self.ctx.robot.set_velocities(self.idx, [left / self.radius, right / self.radius], [self.torque] * 2)
 
