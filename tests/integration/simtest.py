@@ -16,6 +16,8 @@ from std_srvs.srv import Empty
 from tf2_msgs.msg import TFMessage
 
 SIM = "/bullet_sim"
+#: m / rad: a driving body stays this close to its rest height, and tilts less than this (drive_check's bounds).
+from diffbot_sim.drive_check import HEIGHT_TOLERANCE, MAX_TILT  # noqa: E402
 
 
 def yaw_of(q):
@@ -55,6 +57,57 @@ class Latest:
     def get(self):
         with self.lock:
             return self.msg
+
+
+class Truth:
+    """The ground truth of one robot's body (bullet_sim's ``~ground_truth``, published when
+    ``~publish_ground_truth`` is set): every message kept as a drive_check.BodySample (the callback only
+    stores). Drive checks judge the body by it: odometry is the robot's claim, this is where it is."""
+
+    def __init__(self, topic=SIM + "/ground_truth"):
+        from diffbot_sim import drive_check
+
+        self._sample = drive_check.body_sample
+        self.lock = threading.Lock()
+        self.samples = []
+        self.sub = rospy.Subscriber(topic, Odometry, self._keep, queue_size=1000)
+
+    def _keep(self, msg):
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        sample = self._sample(msg.header.stamp.to_sec(), (p.x, p.y, p.z), (q.x, q.y, q.z, q.w))
+        with self.lock:
+            self.samples.append(sample)
+
+    def last(self):
+        with self.lock:
+            return self.samples[-1] if self.samples else None
+
+    def between(self, start, end):
+        """Samples stamped in [start, end] (sim time)."""
+        with self.lock:
+            return [s for s in self.samples if start <= s.t <= end]
+
+    def ride(self, start, end, height=0.0, what="driving"):
+        """The body between two sim times, judged by drive_check.ride (at ``height``, upright); raises
+        AssertionError naming what went wrong."""
+        from diffbot_sim import drive_check
+
+        body = self.between(start, end)
+        result = drive_check.ride(body, height, what)
+        if not result.passed:
+            raise AssertionError("; ".join(result.failures))
+        return body
+
+
+def assert_upright(pose, height, what):
+    """A geometry_msgs/Pose of a driven robot (from /gazebo/get_model_state) rests at ``height`` and upright."""
+    from diffbot_sim import drive_check
+
+    sample = drive_check.body_sample(0.0, (pose.position.x, pose.position.y, pose.position.z),
+                                     (pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w))
+    if not (abs(sample.z - height) < HEIGHT_TOLERANCE and sample.tilt < MAX_TILT):
+        raise AssertionError(f"{what}: the body is at height {sample.z:.3f} m (rest height {height} m), tilted "
+                             f"{sample.tilt:.3f} rad")
 
 
 class Recorder:

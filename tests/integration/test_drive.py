@@ -1,5 +1,8 @@
 #!/usr/bin/env python3
-"""Driving behaviour: straight, turn in place, arc, reverse, 1 Hz commands, joint_states, /clock."""
+"""Driving behaviour: straight, turn in place, arc, reverse, 1 Hz commands, joint_states, /clock.
+
+Every motion is judged on the body (the ground truth: it moves and turns as commanded, staying upright at its
+rest height, base_footprint on the ground) and, separately, on the robot's odometry."""
 import math
 import statistics
 import sys
@@ -8,7 +11,7 @@ import unittest
 import rospy
 import rostest
 
-from simtest import Recorder, reset_robot, yaw_of, finite_odom
+from simtest import Recorder, Truth, reset_robot, yaw_of, finite_odom
 
 RADIUS = 0.032
 SEPARATION = 0.2
@@ -26,13 +29,15 @@ class DriveTest(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("test_drive")
         cls.rec = Recorder()
+        cls.truth = Truth()
         cls.rec.wait_connected()
 
     def setUp(self):
         reset_robot(self.rec)
 
     def _segment(self, linear, angular, settle=1.0, duration=4.0):
-        """Command, let it settle, then return odom messages over ``duration`` sim seconds."""
+        """Command, let it settle, then return odom messages over ``duration`` sim seconds; the body must stay
+        upright on the ground meanwhile (its ground truth samples are in ``self.body``)."""
         rec = self.rec
         rec.send_until_seen(linear, angular)
         t0 = rec.sim_time() + settle
@@ -40,7 +45,16 @@ class DriveTest(unittest.TestCase):
         last = rec.odom_after(first.header.stamp.to_sec() + duration)
         msgs = [m for m in rec.snapshot(rec.odom)
                 if first.header.stamp <= m.header.stamp <= last.header.stamp]
+        start, end = first.header.stamp.to_sec(), last.header.stamp.to_sec()
+        rec.wait(lambda: self.truth.between(end, end + 1.0), 30.0, "the ground truth of the segment's end")
+        self.body = self.truth.ride(start, end, height=0.0)
         return first, last, msgs
+
+    def body_moved(self):
+        """(distance [m], turned [rad], summed) of the body over the last segment, by ground truth."""
+        body = self.body
+        turned = sum(math.atan2(math.sin(b.yaw - a.yaw), math.cos(b.yaw - a.yaw)) for a, b in zip(body, body[1:]))
+        return math.hypot(body[-1].x - body[0].x, body[-1].y - body[0].y), turned
 
     def test_straight(self):
         v = 0.5
@@ -54,10 +68,14 @@ class DriveTest(unittest.TestCase):
         self.assertLess(dyaw, 0.05)
         self.assertAlmostEqual(median_twist(msgs)[0], v, delta=0.05 * v)
         self.assertTrue(all(finite_odom(m) for m in msgs))
+        moved, turned = self.body_moved()
+        self.assertAlmostEqual(moved, v * dt, delta=0.05 * v * dt, msg=f"the body moved {moved} m in {dt} s")
+        self.assertLess(abs(turned), 0.05, "the body kept its heading")
 
     def test_reverse_twist_is_negative(self):
         first, last, msgs = self._segment(-0.3, 0.0)
         self.assertLess(last.pose.pose.position.x, first.pose.pose.position.x)
+        self.assertLess(self.body[-1].x, self.body[0].x - 0.5, "the body backed up")
         self.assertAlmostEqual(median_twist(msgs)[0], -0.3, delta=0.03)
 
     def test_turn_in_place(self):
@@ -74,6 +92,9 @@ class DriveTest(unittest.TestCase):
         p0, p1 = first.pose.pose.position, last.pose.pose.position
         self.assertLess(math.hypot(p1.x - p0.x, p1.y - p0.y), 0.05)
         self.assertAlmostEqual(median_twist(msgs)[1], w, delta=0.05 * w)
+        moved, body_turned = self.body_moved()
+        self.assertAlmostEqual(body_turned, w * dt, delta=0.05 + 0.05 * w * dt, msg="the body turned as told")
+        self.assertLess(moved, 0.05, "the body turned in place")
 
     def test_arc(self):
         v, w = 0.3, 0.5
@@ -88,6 +109,8 @@ class DriveTest(unittest.TestCase):
         self.assertAlmostEqual(turned, w * (last.header.stamp - first.header.stamp).to_sec(), delta=0.1)
         self.assertGreater(last.pose.pose.position.x, 0.0)
         self.assertGreater(last.pose.pose.orientation.z, 0.0)
+        _, body_turned = self.body_moved()
+        self.assertAlmostEqual(body_turned, w * (last.header.stamp - first.header.stamp).to_sec(), delta=0.1)
 
     def test_one_hertz_commands_keep_it_moving(self):
         """Like `rostopic pub -r 1`: a command each sim second; the robot never stops in between."""

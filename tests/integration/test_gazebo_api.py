@@ -25,7 +25,7 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty
 
-from simtest import Latest, yaw_of
+from simtest import Latest, assert_upright, yaw_of
 from simtest import wait_for as wait
 
 GZ = "/gazebo"
@@ -110,6 +110,7 @@ class GazeboApiTest(unittest.TestCase):
         self.assertAlmostEqual(yaw_of(start.pose.orientation), math.pi / 2, delta=0.02)
         self.drive("/bot1", 0.3, 0.0, 2.0)
         end = self.model("bot1")
+        assert_upright(end.pose, 0.0, "bot1 after the drive")
         self.assertGreater(end.pose.position.y - start.pose.position.y, 0.3)
         self.assertLess(abs(end.pose.position.x - start.pose.position.x), 0.1)
         self.assertIn("bot1", self.world().model_names)
@@ -155,6 +156,7 @@ class GazeboApiTest(unittest.TestCase):
         self.assertAlmostEqual(there.pose.position.y, -6.0, delta=0.03)
         self.drive("/bot_tp", 0.3, 0.0, 2.0)
         end = self.model("bot_tp")
+        assert_upright(end.pose, 0.0, "bot_tp after the teleport and the drive")
         self.assertLess(end.pose.position.x, 4.0 - 0.3, "facing -x after the teleport, it drives towards -x")
         self.assertAlmostEqual(end.pose.position.y, -6.0, delta=0.1)
         # relative to another model: bot_tp seen from push_box (yaw 0)

@@ -19,7 +19,7 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState, LaserScan
 
-from simtest import Latest, yaw_of
+from simtest import Latest, assert_upright, yaw_of
 from simtest import wait_for as wait
 
 WALL_Y = 5.0
@@ -99,7 +99,9 @@ class GazeboWayTest(unittest.TestCase):
                 v = self.state(robot["model"]).twist.linear
                 return math.hypot(v.x, v.y) < 0.01
             wait(stopped, 10.0, f"{robot['model']} at rest after the drive")
-            end = self.state(robot["model"]).pose.position
+            end_pose = self.state(robot["model"]).pose
+            assert_upright(end_pose, 0.0, f"{robot['model']} after the drive")
+            end = end_pose.position
             self.assertGreater(end.y - start.y, 0.4, f"{robot['model']} drove forward (+y)")
             self.assertLess(end.y, WALL_Y - 0.2)
             self.assertGreater(odom.get().pose.pose.position.x, 0.3, "controller odometry counts forward")

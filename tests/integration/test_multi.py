@@ -10,7 +10,7 @@ import rostest
 import tf2_ros
 from geometry_msgs.msg import Twist
 
-from simtest import Recorder, yaw_of, finite_odom
+from simtest import Recorder, Truth, yaw_of, finite_odom
 
 SIM = "/bullet_sim"
 
@@ -20,6 +20,7 @@ class MultiRobotTest(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("test_multi")
         cls.rec = Recorder(odom="/robot1/odom", joint_states="/robot1/joint_states", extra_odom="/robot2/odom")
+        cls.truth = {name: Truth(f"{SIM}/{name}/ground_truth") for name in ("robot1", "robot2")}
         cls.cmd = {name: rospy.Publisher(f"/{name}/cmd_vel", Twist, queue_size=10) for name in ("robot1", "robot2")}
         cls.rec.wait(lambda: all(p.get_num_connections() > 0 for p in cls.cls_pubs()), 20.0,
                      "the simulator to subscribe both cmd_vel topics")
@@ -81,6 +82,16 @@ class MultiRobotTest(unittest.TestCase):
         self.assertLess(math.hypot(b1.pose.pose.position.x - b0.pose.pose.position.x,
                                    b1.pose.pose.position.y - b0.pose.pose.position.y), 0.05)
         self.assertTrue(all(finite_odom(m) for m in rec.snapshot(rec.odom) + rec.snapshot(rec.extra)))
+        # The bodies (ground truth), not only their odometry: upright on the ground, each doing as told.
+        end = a1.header.stamp.to_sec()
+        rec.wait(lambda: all(t.between(end, end + 1.0) for t in self.truth.values()), 30.0, "both ground truths")
+        one = self.truth["robot1"].ride(start, end)
+        two = self.truth["robot2"].ride(start, end, what="turning")
+        self.assertGreater(one[-1].x - one[0].x, 0.6, "robot1's body drove ahead")
+        self.assertLess(abs(one[-1].yaw - one[0].yaw), 0.05)
+        self.assertGreater(abs(math.atan2(math.sin(two[-1].yaw - two[0].yaw), math.cos(two[-1].yaw - two[0].yaw))),
+                           0.5, "robot2's body turned")
+        self.assertLess(math.hypot(two[-1].x - two[0].x, two[-1].y - two[0].y), 0.05, "in place")
 
     def test_3_tf_tree_per_robot(self):
         """bullet_sim's odom -> base_footprint joins robot_state_publisher's tf_prefix'ed links."""
