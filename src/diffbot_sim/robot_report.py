@@ -364,10 +364,15 @@ def _m(value):
     return "?" if value is None or not math.isfinite(value) else f"{value:.4g} m"
 
 
+def _mm(value):
+    """``value`` to the millimetre, without a "-0.000" for a hair below zero."""
+    return f"{round(value, 3) + 0.0:.3f}"
+
+
 def format_rest(rest):
     """Lines for the body at rest before driving (a :class:`diffbot_sim.drive_check.Rest`)."""
-    expected = "" if rest.expected is None else f" (its geometry rests at {rest.expected:.3f} m)"
-    lines = [f"at rest (ground truth): height {rest.height:.3f} m{expected}, tilt {rest.tilt:.3f} rad, "
+    expected = "" if rest.expected is None else f" (its geometry rests at {_mm(rest.expected)} m)"
+    lines = [f"at rest (ground truth): height {_mm(rest.height)} m{expected}, tilt {rest.tilt:.3f} rad, "
              f"height varied {rest.spread:.3f} m: {'PASS' if rest.passed else 'FAIL'}"]
     lines.extend(f"  {text}" for text in rest.failures)
     return lines
@@ -375,7 +380,7 @@ def format_rest(rest):
 
 def _format_ride(ride):
     """Lines for the body during a motion (a :class:`diffbot_sim.drive_check.Ride`)."""
-    lines = [f"  body (ground truth): height {ride.low:.3f}..{ride.high:.3f} m, tilt up to {ride.tilt:.3f} rad: "
+    lines = [f"  body (ground truth): height {_mm(ride.low)}..{_mm(ride.high)} m, tilt up to {ride.tilt:.3f} rad: "
              f"{'PASS' if ride.passed else 'FAIL'}"]
     lines.extend(f"    {text}" for text in ride.failures)
     return lines

@@ -47,6 +47,7 @@ def test_fixed_caster_drives(tmp_path):
     assert any(line.startswith("  NOT simulated  sensor imu (type imu)") for line in lines)
     assert any(line.startswith("straight 0.2 m/s x 4 s: ") and line.endswith(": PASS") for line in lines), out
     assert any(line.startswith("turn 0.5 rad/s x 4 s: ") and line.endswith(": PASS") for line in lines), out
+    assert any(line.startswith("at rest (ground truth): height 0.000 m") for line in lines), out
     assert lines[-1] == "result: PASS: the robot drives"
 
 
@@ -64,8 +65,21 @@ def test_ros_control_4wd_with_its_yaml_drives(tmp_path):
     assert any("/mobile_base_controller/k_l" in line for line in lines)
     assert any(line.startswith("drive test (") and "/mobile_base_controller/cmd_vel -> /mobile_base_controller/odom"
                in line for line in lines), out
-    assert sum(line.endswith(": PASS") for line in lines) == 2, out
+    assert sum(line.endswith(": PASS") for line in lines) == 5, out  # at rest, 2 motions, the body in each
     assert lines[-1] == "result: PASS: the robot drives"
+
+
+def test_an_outdoor_4wd_spawned_into_the_ground_rests_on_it_and_drives(tmp_path):
+    # inertial_link_4wd: an inertia-less base_link, its mass in an inertial_link, wheels 0.132 m into the ground
+    # at z 0 (where robot_check spawns it); it used to be thrown metres up while its encoder odometry said PASS.
+    proc = run_check(tmp_path, os.path.join(ROBOTS, "inertial_link_4wd.urdf"),
+                     os.path.join(ROBOTS, "inertial_link_4wd.yaml"), timeout=90)
+    out = proc.stdout
+    assert proc.returncode == 0, out + proc.stderr
+    rest = [line for line in out.splitlines() if line.startswith("at rest (ground truth): ")]
+    assert len(rest) == 1 and rest[0].startswith("at rest (ground truth): height 0.132 m (its geometry rests at "
+                                                 "0.132 m), tilt 0.000 rad") and rest[0].endswith(": PASS"), out
+    assert sum(line.startswith("  body (ground truth): height 0.13") for line in out.splitlines()) == 2, out
 
 
 def test_a_robot_without_a_drive_fails(tmp_path):
