@@ -24,6 +24,7 @@ import numpy as np
 from .config import _number
 from .errors import ConfigError
 from .model import tag_value
+from .tag_values import tag_number
 
 CAMERA_TYPES = ("camera", "depth")
 #: ``<image><format>`` -> ROS encoding (GazeboRosCameraUtils). Rendered here: these three.
@@ -56,18 +57,12 @@ class CameraConfig:
         return ENCODINGS.get(self.format, "rgb8")
 
 
-def _num(element, tag, where, default, **limits):
+def _num(element, tag, where, default, notes, integer=False, **limits):
+    """The number in ``element``'s ``<tag>`` (``default`` when absent or empty), read as Gazebo reads it."""
     el = element.find(tag) if element is not None else None
     if el is None or not tag_value(el):
         return default
-    return _number(f"<{tag}> of {where}", tag_value(el), **limits)
-
-
-def _whole(element, tag, where, default):
-    value = _num(element, tag, where, default, low=1)
-    if value != int(value):
-        raise ConfigError(f"<{tag}> of {where}", value, "a whole number >= 1")
-    return int(value)
+    return tag_number(f"<{tag}> of {where}", tag_value(el), notes, integer=integer, **limits)
 
 
 def parse_sensor(element, path, name=None):
@@ -78,7 +73,8 @@ def parse_sensor(element, path, name=None):
     """
     cfg = CameraConfig(name=name if name is not None else (element.get("name") or ""),
                        type=(element.get("type") or "").strip(), path=path)
-    cfg.update_rate = _num(element, "update_rate", path, 0.0, low=0.0)
+    notes = cfg.warnings
+    cfg.update_rate = _num(element, "update_rate", path, 0.0, notes, low=0.0)
     pose = element.find("pose")
     if pose is not None and (pose.text or "").strip():
         parts = pose.text.split()
@@ -91,21 +87,21 @@ def parse_sensor(element, path, name=None):
         cfg.warnings.append(f"{path}: no <camera> element; SDF defaults apply (320x240, hfov 1.047)")
         return cfg
     where = f"{path}/camera"
-    cfg.hfov = _num(camera, "horizontal_fov", where, 1.047, low=0.1, high=6.283)
+    cfg.hfov = _num(camera, "horizontal_fov", where, 1.047, notes, low=0.1, high=6.283)
     if cfg.hfov >= math.pi:
         raise ConfigError(f"<horizontal_fov> of {where}", cfg.hfov, "less than pi for a pinhole camera "
                           "(wider lenses are not simulated)")
     image = camera.find("image")
-    cfg.width = _whole(image, "width", f"{where}/image", 320)
-    cfg.height = _whole(image, "height", f"{where}/image", 240)
+    cfg.width = _num(image, "width", f"{where}/image", 320, notes, integer=True, low=1)
+    cfg.height = _num(image, "height", f"{where}/image", 240, notes, integer=True, low=1)
     fmt = image.find("format") if image is not None else None
     if fmt is not None and tag_value(fmt):
         cfg.format = tag_value(fmt)
         if cfg.format not in ENCODINGS:
             cfg.warnings.append(f"{where}/image/format: {cfg.format} is rendered as R8G8B8 (rgb8) here")
     clip = camera.find("clip")
-    cfg.near = _num(clip, "near", f"{where}/clip", 0.1, low=0.0, low_open=True)
-    cfg.far = _num(clip, "far", f"{where}/clip", 100.0, low=0.0, low_open=True)
+    cfg.near = _num(clip, "near", f"{where}/clip", 0.1, notes, low=0.0, low_open=True)
+    cfg.far = _num(clip, "far", f"{where}/clip", 100.0, notes, low=0.0, low_open=True)
     if cfg.far <= cfg.near:
         raise ConfigError(f"<clip><far> of {where}", cfg.far, f"a number > <clip><near> {cfg.near:g}")
     noise = camera.find("noise")
@@ -114,8 +110,8 @@ def parse_sensor(element, path, name=None):
         if ntype not in ("gaussian", "none"):
             raise ConfigError(f"<type> of {where}/noise", ntype, "gaussian or none")
         if ntype == "gaussian":
-            cfg.noise_mean = _num(noise, "mean", f"{where}/noise", 0.0)
-            cfg.noise_stddev = _num(noise, "stddev", f"{where}/noise", 0.0, low=0.0)
+            cfg.noise_mean = _num(noise, "mean", f"{where}/noise", 0.0, notes)
+            cfg.noise_stddev = _num(noise, "stddev", f"{where}/noise", 0.0, notes, low=0.0)
     for tag in ("distortion", "lens", "intrinsics"):
         if camera.find(tag) is not None:
             cfg.warnings.append(f"{where}/{tag}: not simulated (an ideal pinhole image is rendered)")

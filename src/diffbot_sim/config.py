@@ -10,6 +10,7 @@ from dataclasses import asdict, dataclass, field, fields
 from typing import List, Optional
 
 from .errors import ConfigError, ModelError
+from .tag_values import tag_number
 
 #: Wheel speed cap [rad/s] when neither ``~max_wheel_velocity`` nor the URDF ``<limit velocity>`` gives one:
 #: keeps a 1e308 command from reaching the physics as an absurd motor target.
@@ -218,12 +219,12 @@ def drive_config(model, block, params, notes=None):
         for key, value in ROS2_DRIVE_DEFAULTS.items():
             setattr(cfg, key, value)
     sources = []
-    if block is not None:
-        sources.append((block.values, lambda k: f"<{block.tag(k)}> of {block.path}"))
-    sources.append((given, lambda k: f"~{k}"))
-    for values, label in sources:
+    if block is not None:  # tag text, read as Gazebo reads it; then the typed private parameters, strictly
+        sources.append((block.values, lambda k: f"<{block.tag(k)}> of {block.path}", True))
+    sources.append((given, lambda k: f"~{k}", False))
+    for values, label, from_tag in sources:
         for key, value in values.items():
-            setattr(cfg, key, _drive_value(key, value, label(key), notes))
+            setattr(cfg, key, _drive_value(key, value, label(key), notes, from_tag))
     if block is not None and block.dialect == "ros1" and "publish_odom_tf" not in given \
             and block.values.get("publish_odom") is not None and not cfg.publish_odom:
         cfg.publish_odom_tf = False  # ROS 1 publishTf=false removes the odom topic and its TF together
@@ -250,7 +251,7 @@ def drive_config(model, block, params, notes=None):
     return cfg
 
 
-def joint_state_config(model, block, drive):
+def joint_state_config(model, block, drive, notes=None):
     """JointStateConfig from the joint-state plugin and, when the drive says so, its wheels.
 
     Raises:
@@ -263,7 +264,7 @@ def joint_state_config(model, block, drive):
             if key == "joints":
                 cfg.joints = list(value)
             elif key == "update_rate":
-                cfg.update_rate = _number(label, value, low=0.0)
+                cfg.update_rate = tag_number(label, value, notes if notes is not None else [], low=0.0)
             elif key in ("topic", "namespace"):
                 setattr(cfg, key, _string(label, value, allow_empty=key == "namespace"))
         for jname in cfg.joints:
@@ -379,9 +380,13 @@ def as_params(cfg):
 
 
 
-def _drive_value(key, value, label, notes):
+def _drive_value(key, value, label, notes, from_tag=False):
     """``value`` of DriveConfig field ``key``, validated; a value Gazebo tolerates with a warning appends
-    that warning to ``notes``."""
+    that warning to ``notes``. A number ``from_tag`` (a plugin tag's text) is read as Gazebo reads it: its
+    leading number (:func:`diffbot_sim.tag_values.tag_number`)."""
+    def number(**limits):
+        return tag_number(label, value, notes, **limits) if from_tag else _number(label, value, **limits)
+
     if key in ("left_joints", "right_joints"):
         names = [value] if isinstance(value, str) else value
         if not isinstance(names, (list, tuple)) or not all(isinstance(n, str) and n for n in names):
@@ -391,11 +396,11 @@ def _drive_value(key, value, label, notes):
             out.extend(part for part in item.replace(",", " ").split() if part)
         return out
     if key in ("wheel_separation", "wheel_diameter"):
-        return _number(label, value, low=0.0, low_open=True)
+        return number(low=0.0, low_open=True)
     if key in ("max_wheel_torque", "max_wheel_acceleration", "update_rate"):
-        return _number(label, value, low=0.0)
+        return number(low=0.0)
     if key in ("covariance_x", "covariance_y", "covariance_yaw"):
-        return _number(label, value, low=0.0)
+        return number(low=0.0)
     if key in ("publish_odom", "publish_odom_tf", "publish_wheel_joint_state"):
         return _bool(label, value)
     if key == "odometry_source":

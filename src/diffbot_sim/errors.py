@@ -38,7 +38,13 @@ class ConfigError(DiffbotSimError):
     def __init__(self, name, value, expected):
         self.name = name
         self.value = value
+        self.expected = expected
         super().__init__(f"parameter {name}: got {value!r}, expected {expected}")
+
+
+class PluginNotLoaded(ModelError):
+    """A plugin Gazebo would not load while loading the rest of the robot (its link is not in the model): the
+    simulator warns once, naming it, and goes on without it, as Gazebo does."""
 
 
 class TerminalError(DiffbotSimError):

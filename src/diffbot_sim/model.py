@@ -10,7 +10,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Tuple
 
-from .errors import ModelError
+from .errors import ConfigError, ModelError
+from .tag_values import tag_number
 
 #: Per-link ``<gazebo reference>`` tags that carry a number (ODE surface and contact parameters).
 SURFACE_NUMBERS = ("mu1", "mu2", "kp", "kd", "minDepth", "maxVel", "laserRetro")
@@ -149,9 +150,9 @@ class RobotModel:
                 try:
                     if child.tag == "fdir1":
                         values["fdir1"] = _vec(text, self.source, f"{block.path}/fdir1")
-                    else:
-                        values[child.tag] = _float(text, self.source, f"{block.path}/{child.tag}")
-                except ModelError as err:
+                    else:  # read as Gazebo's URDF reader does (std::stod: the leading number)
+                        values[child.tag] = tag_number(f"{self.source}: {block.path}/{child.tag}", text, self.warnings)
+                except (ModelError, ConfigError) as err:
                     self.warnings.append(f"{err}; ignored (Gazebo's default applies)")
         self._surfaces[link] = values
         return dict(values)
@@ -250,7 +251,10 @@ def parse_urdf(text, source="robot_description"):
         ref = el.get("reference")
         path = f"/robot/gazebo[@reference='{ref}']" if ref else f"/robot/gazebo[{index}]"
         if ref and ref not in links and ref not in joints:
-            model.warnings.append(f"{source}: {path} names no link or joint of the model; its tags are ignored")
+            # Gazebo drops such a block (a sensor in it too) and loads the rest of the robot.
+            model.warnings.append(f"{source}: {path} names no link or joint of the model; the block (its tags, "
+                                  "sensors and plugins) is ignored, as in Gazebo")
+            continue
         model.gazebo.append(GazeboBlock(ref, el, path))
     return model
 

@@ -21,7 +21,8 @@ import math
 import random
 import zlib
 
-from .errors import ModelError
+from .errors import ConfigError, ModelError
+from .tag_values import tag_number
 
 SDF_KINDS = ("none", "gaussian", "gaussian_quantized")
 
@@ -67,27 +68,27 @@ def plain(generator, stddev):
     return Gaussian(generator, stddev=stddev)
 
 
-def _float(element, tag, where, default=0.0):
+def _float(element, tag, where, notes, default=0.0):
+    """The number in ``element``'s ``<tag>``, read as Gazebo reads it (its leading number)."""
     child = element.find(tag)
     if child is None:
         return default
     text = (child.text or "").strip()
     try:
-        value = float(text)
-    except ValueError:
-        raise ModelError(f"<{tag}> must be a number, got '{text}'", where) from None
-    if not math.isfinite(value):
-        raise ModelError(f"<{tag}> must be finite, got '{text}'", where)
-    return value
+        return tag_number(f"<{tag}> of {where}", text, notes)
+    except ConfigError:
+        raise ModelError(f"<{tag}> must be a finite number, got '{text}'", where) from None
 
 
-def sdf_noise(element, generator, where):
+def sdf_noise(element, generator, where, notes=None):
     """A Gaussian from an SDF ``<noise>`` element (1.5+ with a ``type`` attribute, or a 1.4 block with a
-    ``<type>`` child); None for no element or type ``none``.
+    ``<type>`` child); None for no element or type ``none``. What Gazebo drops after a number is named in
+    ``notes``.
 
     Raises:
         ModelError: an unknown type or a value that is not a number (naming ``where``).
     """
+    notes = notes if notes is not None else []
     if element is None:
         return None
     kind = element.get("type")
@@ -98,12 +99,13 @@ def sdf_noise(element, generator, where):
         raise ModelError(f"noise type '{kind}' is not one of {', '.join(SDF_KINDS)}", where)
     if kind == "none":
         return None
-    stddev = _float(element, "stddev", where)
-    bias_stddev = _float(element, "bias_stddev", where)
+    stddev = _float(element, "stddev", where, notes)
+    bias_stddev = _float(element, "bias_stddev", where, notes)
     if stddev < 0 or bias_stddev < 0:
         raise ModelError("noise <stddev> and <bias_stddev> cannot be negative", where)
-    return Gaussian(generator, _float(element, "mean", where), stddev, _float(element, "bias_mean", where),
-                    bias_stddev, max(_float(element, "precision", where), 0.0))
+    return Gaussian(generator, _float(element, "mean", where, notes), stddev,
+                    _float(element, "bias_mean", where, notes), bias_stddev,
+                    max(_float(element, "precision", where, notes), 0.0))
 
 
 def apply(models, values):

@@ -24,6 +24,7 @@ import numpy as np
 
 from .config import _bool, _number
 from .errors import ConfigError
+from .tag_values import tag_number
 from .model import tag_value
 from .transforms import rpy_matrix
 
@@ -120,11 +121,12 @@ def _child(element, *names):
     return None
 
 
-def _num(element, tag, where, default, **limits):
+def _num(element, tag, where, default, notes, integer=False, **limits):
+    """The number in ``element``'s ``<tag>`` (``default`` when absent), read as Gazebo reads it."""
     el = element.find(tag) if element is not None else None
     if el is None:
         return default
-    return _number(f"<{tag}> of {where}", tag_value(el), **limits)
+    return tag_number(f"<{tag}> of {where}", tag_value(el), notes, integer=integer, **limits)
 
 
 def _pose(text, where):
@@ -135,17 +137,14 @@ def _pose(text, where):
     return tuple(values[:3]), tuple(values[3:])
 
 
-def _axis(element, where, default_samples):
+def _axis(element, where, default_samples, notes):
     axis = ScanAxis(samples=default_samples)
     if element is None:
         return axis
-    samples = _num(element, "samples", where, default_samples, low=1)
-    if samples != int(samples):
-        raise ConfigError(f"<samples> of {where}", samples, "a whole number >= 1")
-    axis.samples = int(samples)
-    axis.resolution = _num(element, "resolution", where, 1.0, low=0.0, low_open=True)
-    axis.min_angle = _num(element, "min_angle", where, 0.0)
-    axis.max_angle = _num(element, "max_angle", where, 0.0)
+    axis.samples = _num(element, "samples", where, default_samples, notes, integer=True, low=1)
+    axis.resolution = _num(element, "resolution", where, 1.0, notes, low=0.0, low_open=True)
+    axis.min_angle = _num(element, "min_angle", where, 0.0, notes)
+    axis.max_angle = _num(element, "max_angle", where, 0.0, notes)
     if axis.max_angle < axis.min_angle:
         raise ConfigError(f"<max_angle> of {where}", axis.max_angle, f"a number >= <min_angle> {axis.min_angle:g}")
     return axis
@@ -159,7 +158,8 @@ def parse_sensor(element, path, name=None):
     """
     stype = (element.get("type") or "").strip()
     cfg = RayConfig(name=name if name is not None else (element.get("name") or ""), type=stype, path=path)
-    cfg.update_rate = _num(element, "update_rate", path, 0.0, low=0.0)
+    notes = cfg.warnings
+    cfg.update_rate = _num(element, "update_rate", path, 0.0, notes, low=0.0)
     for tag in ("always_on", "visualize"):
         el = element.find(tag)
         if el is not None:
@@ -174,12 +174,13 @@ def parse_sensor(element, path, name=None):
         ray = element.makeelement("ray", {})
     where = f"{path}/{ray.tag}"
     scan = ray.find("scan")
-    cfg.horizontal = _axis(scan.find("horizontal") if scan is not None else None, f"{where}/scan/horizontal", 640)
-    cfg.vertical = _axis(scan.find("vertical") if scan is not None else None, f"{where}/scan/vertical", 1)
+    cfg.horizontal = _axis(scan.find("horizontal") if scan is not None else None, f"{where}/scan/horizontal", 640,
+                           notes)
+    cfg.vertical = _axis(scan.find("vertical") if scan is not None else None, f"{where}/scan/vertical", 1, notes)
     rng = ray.find("range")
-    cfg.range_min = _num(rng, "min", f"{where}/range", 0.0, low=0.0)
-    cfg.range_max = _num(rng, "max", f"{where}/range", 0.0, low=0.0)
-    cfg.range_resolution = _num(rng, "resolution", f"{where}/range", 0.0, low=0.0)
+    cfg.range_min = _num(rng, "min", f"{where}/range", 0.0, notes, low=0.0)
+    cfg.range_max = _num(rng, "max", f"{where}/range", 0.0, notes, low=0.0)
+    cfg.range_resolution = _num(rng, "resolution", f"{where}/range", 0.0, notes, low=0.0)
     if cfg.range_max <= cfg.range_min:
         raise ConfigError(f"<range><max> of {where}", cfg.range_max, f"a number > <range><min> {cfg.range_min:g}")
     noise = ray.find("noise")
@@ -189,9 +190,11 @@ def parse_sensor(element, path, name=None):
         ntype = (tag_value(type_el) if type_el is not None else "none").strip().lower() or "none"
         if ntype not in ("none", "gaussian"):
             raise ConfigError(f"<type> of {nwhere}", ntype, "gaussian or none (a ray sensor's noise types)")
-        cfg.noise = Noise(ntype, _num(noise, "mean", nwhere, 0.0), _num(noise, "stddev", nwhere, 0.0, low=0.0),
-                          _num(noise, "bias_mean", nwhere, 0.0), _num(noise, "bias_stddev", nwhere, 0.0, low=0.0),
-                          _num(noise, "precision", nwhere, 0.0, low=0.0))
+        cfg.noise = Noise(ntype, _num(noise, "mean", nwhere, 0.0, notes),
+                          _num(noise, "stddev", nwhere, 0.0, notes, low=0.0),
+                          _num(noise, "bias_mean", nwhere, 0.0, notes),
+                          _num(noise, "bias_stddev", nwhere, 0.0, notes, low=0.0),
+                          _num(noise, "precision", nwhere, 0.0, notes, low=0.0))
     if stype.startswith("gpu"):
         cfg.warnings.append(f"{path}: a {stype} sensor is cast against collision shapes here (Gazebo's GPU "
                             "ray sees visuals)")

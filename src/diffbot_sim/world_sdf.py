@@ -32,7 +32,8 @@ import math
 import os
 import xml.etree.ElementTree as ET
 
-from .errors import ModelError
+from .errors import ConfigError, ModelError
+from .tag_values import tag_number
 from .transforms import qmul as _qmul
 from .world import IDENTITY, Body, Shape, WorldDescription
 
@@ -340,10 +341,18 @@ class _Reader:
         return values
 
     def number(self, el, tag, default, src, path, positive=False):
+        """The number in ``<tag>``, read as sdformat reads it (its leading number, the rest dropped with one
+        warning)."""
         text = _text(el, tag)
         if text is None:
             return default
-        (value,) = self.floats(text, 1, src, f"{path}/{tag}", f"<{tag}>")
+        notes = []
+        try:
+            value = tag_number(f"{src.path}: {path}/{tag}", text, notes)
+        except ConfigError:
+            raise ModelError(f"<{tag}> '{text}' is not 1 finite number", src.path, f"{path}/{tag}") from None
+        for note in notes:
+            self.warn(note)
         if positive and value <= 0:
             raise ModelError(f"<{tag}> {text} must be > 0", src.path, f"{path}/{tag}")
         return value

@@ -37,7 +37,7 @@ def test_parse_full_sensor():
 
 @pytest.mark.parametrize("body, tag", [
     ("<camera><image><width>0</width></image></camera>", "<width>"),
-    ("<camera><image><width>10.5</width></image></camera>", "<width>"),
+    ("<camera><image><width>wide</width></image></camera>", "<width>"),
     ("<camera><clip><near>1</near><far>0.5</far></clip></camera>", "<clip><far>"),
     ("<camera><horizontal_fov>3.5</horizontal_fov></camera>", "<horizontal_fov>"),
     ("<camera><horizontal_fov>wide</horizontal_fov></camera>", "<horizontal_fov>"),
@@ -46,6 +46,14 @@ def test_bad_values_name_the_tag(body, tag):
     with pytest.raises(ConfigError) as err:
         sensor(f'<sensor type="camera" name="c">{body}</sensor>')
     assert tag in str(err.value)
+
+
+def test_a_computed_width_is_read_as_gazebo_reads_it():
+    cfg = sensor('<sensor type="camera" name="c"><camera><image><width>640.7</width></image></camera></sensor>')
+    assert cfg.width == 640
+    assert [w for w in cfg.warnings if "<width>" in w] == [
+        f"<width> of {PATH}/camera/image: took 640 from '640.7', as Gazebo's SDF reader (std::stoul) "
+        "does"]
 
 
 def test_intrinsics_as_gazebo():

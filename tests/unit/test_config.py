@@ -104,6 +104,22 @@ def test_ros1_publish_tf_false_turns_off_odom_and_its_tf(parse, make_urdf):
     assert cfg.publish_odom is False and cfg.publish_odom_tf is True
 
 
+def test_plugin_tag_numbers_are_read_as_gazebo_reads_them(parse, make_urdf):
+    notes = []
+    model = parse(make_urdf(gazebo=_gazebo(_ros1("<wheelSeparation>0.31m</wheelSeparation>"
+                                                 "<updateRate>50.0 Hz</updateRate>"))))
+    cfg = drive_config(model, read_plugins(model).diff_drive, {}, notes)
+    assert (cfg.wheel_separation, cfg.update_rate) == (0.31, 50.0)
+    assert len(notes) == 2 and all("as Gazebo's SDF reader (std::stod) does" in n for n in notes)
+    assert any(n.startswith("<wheelSeparation> of /robot/gazebo[1]/plugin[@name='dd']: took 0.31 from '0.31m'")
+               for n in notes), notes
+
+
+def test_private_parameters_stay_strict(parse, make_urdf):
+    with pytest.raises(ConfigError, match=r"~wheel_separation: got '0.31m'"):
+        _drive(parse, make_urdf, _ros1(""), params={"wheel_separation": "0.31m"})
+
+
 def test_ros1_defaults_publish(parse, make_urdf):
     cfg = _drive(parse, make_urdf, _ros1(""))
     assert cfg.publish_odom is True and cfg.publish_odom_tf is True

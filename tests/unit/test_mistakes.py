@@ -55,6 +55,8 @@ def _matching(lines, words):
 WARNED = {
     "gazebo reference naming nothing": ("model", ["/robot/gazebo[@reference='caster_{side}_1_joint']",
                                                   "names no link or joint"]),
+    "a sensor block for a commented-out link": ("model", ["/robot/gazebo[@reference='imu_link']",
+                                                          "names no link or joint", "ignored, as in Gazebo"]),
     "two hardwareInterface entries, left": ("model", ["transmission[@name='left_wheel_trans']",
                                                       "joint[@name='left_wheel_joint']", "2 hardware interfaces",
                                                       "VelocityJointInterface"]),
@@ -120,6 +122,24 @@ def test_meshes_first_shape_kept_and_dotdot_path_resolved(loaded):
         assert len(shapes) == 1 and shapes[0].tag == "mesh"
         assert shapes[0].get("filename").endswith(".obj") and os.path.isfile(shapes[0].get("filename"))
         assert shapes[0].get("scale") == "0.001 0.001 0.001"
+
+
+def test_a_plugin_naming_a_missing_link_is_not_loaded_with_one_warning(loaded):
+    from types import SimpleNamespace
+
+    class NoImuLink:
+        def link_motion(self, name):
+            raise KeyError(name)
+
+    ctx = SimpleNamespace(cfg=config.SimConfig(), model=loaded.model, robot=NoImuLink(), warnings=[])
+    (hector,) = [p for p in loaded.found.others if p.filename == "libhector_gazebo_ros_imu.so"]
+    plugins = []
+    registry._add(ctx, plugins, registry.MODEL_PLUGINS[hector.filename], hector.element, hector.path, {})
+    assert plugins == []
+    assert len(ctx.warnings) == 1 and "plugin[@name='imu_controller']" in ctx.warnings[0] \
+        and "IMU link 'imu_link' is not a link of the model; the plugin is not loaded, as in Gazebo" \
+        in ctx.warnings[0], ctx.warnings
+    assert not [s for s in loaded.found.sensors if s.link == "imu_link"]  # its sensor block went with it
 
 
 def test_plugin_settings_survive_the_mistakes(loaded):

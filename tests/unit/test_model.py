@@ -60,6 +60,23 @@ def test_seed_surface_tags(seed_model):
     assert seed_model.surface("base_link") == {}
 
 
+def test_surface_numbers_are_read_as_gazebos_urdf_reader_reads_them(parse, make_urdf):
+    # sdformat's URDF reader takes <mu1> with std::stod: the leading number; one warning names the tag.
+    model = parse(make_urdf(gazebo='<gazebo reference="left_wheel_link"><mu1>0.5abc</mu1><mu2>0.4</mu2>'
+                                   '<kp>none</kp></gazebo>'))
+    assert model.surface("left_wheel_link") == {"mu1": 0.5, "mu2": 0.4}
+    assert [w for w in model.warnings if "mu1" in w] == [
+        "test.urdf: /robot/gazebo[@reference='left_wheel_link']/mu1: took 0.5 from '0.5abc', as Gazebo's SDF "
+        "reader (std::stod) does"]
+    assert len([w for w in model.warnings if "/kp" in w and "Gazebo's default applies" in w]) == 1
+
+
+def test_a_gazebo_block_naming_nothing_is_dropped_with_one_warning(parse, make_urdf):
+    model = parse(make_urdf(gazebo='<gazebo reference="imu_link"><sensor type="imu" name="imu"/></gazebo>'))
+    assert all(block.reference != "imu_link" for block in model.gazebo)
+    assert len([w for w in model.warnings if "gazebo[@reference='imu_link']" in w and "ignored" in w]) == 1
+
+
 def test_small_robot_geometry_differs_from_seed(parse, make_urdf):
     model = parse(make_urdf(separation=0.34, wheel_radius=0.045))
     assert model.wheel_radius("left_wheel_joint", "x") == pytest.approx(0.045)

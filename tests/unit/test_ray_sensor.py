@@ -60,7 +60,7 @@ def test_lidar_spelling_and_gpu_warning():
 
 @pytest.mark.parametrize("body, tag", [
     (SCAN.format(n=0, res=1, lo=0, hi=1, rmin=0.1, rmax=1, noise=""), "<samples>"),
-    (SCAN.format(n=2.5, res=1, lo=0, hi=1, rmin=0.1, rmax=1, noise=""), "<samples>"),
+    (SCAN.format(n="many", res=1, lo=0, hi=1, rmin=0.1, rmax=1, noise=""), "<samples>"),
     (SCAN.format(n=5, res=0, lo=0, hi=1, rmin=0.1, rmax=1, noise=""), "<resolution>"),
     (SCAN.format(n=5, res=1, lo=1, hi=0, rmin=0.1, rmax=1, noise=""), "<max_angle>"),
     (SCAN.format(n=5, res=1, lo=0, hi=1, rmin=1, rmax=1, noise=""), "<range><max>"),
@@ -69,9 +69,20 @@ def test_lidar_spelling_and_gpu_warning():
     ("<pose>1 2 3</pose>", "<pose>"),
 ])
 def test_sdf_errors_name_the_tag_and_path(body, tag):
+    """A value Gazebo cannot read either (no leading number, out of range) stops the load, naming it."""
     with pytest.raises(ConfigError) as err:
         rs.parse_sensor(sensor(body), "/robot/gazebo[@reference='l']/sensor")
     assert tag in str(err.value) and "/robot/gazebo[@reference='l']/sensor" in str(err.value)
+
+
+def test_a_computed_sample_count_is_read_as_gazebo_reads_it():
+    # A published robot's xacro computes <samples>666.5185185185185</samples>: sdformat's std::stoul takes 666.
+    cfg = rs.parse_sensor(sensor(SCAN.format(n="666.5185185185185", res=1, lo=-2.0944, hi=2.0944, rmin=0.05,
+                                             rmax=25, noise="")), "/robot/gazebo[@reference='l']/sensor")
+    assert cfg.horizontal.samples == 666 and cfg.horizontal.count == 666
+    assert [w for w in cfg.warnings if "<samples>" in w] == [
+        "<samples> of /robot/gazebo[@reference='l']/sensor/ray/scan/horizontal: took 666 from "
+        "'666.5185185185185', as Gazebo's SDF reader (std::stoul) does"]
 
 
 # -- angles -------------------------------------------------------------------------------------------------

@@ -574,6 +574,15 @@ def test_plane_in_dynamic_model_warns_and_is_not_ground(tmp_path):
     assert not world.has_ground and any("non-static" in w for w in world.warnings)
 
 
+def test_a_number_with_a_tail_is_read_as_sdformat_reads_it(tmp_path):
+    path = world_file(tmp_path, '<model name="m"><static>true</static><link name="l"><collision name="c"><geometry>'
+                                '<sphere><radius>0.25m</radius></sphere></geometry></collision></link></model>')
+    world = read(path, [])
+    (body,) = [b for b in world.bodies if b.shapes[0].kind == "sphere"]
+    assert body.shapes[0].size == (0.25,)
+    assert len([w for w in world.warnings if "<radius>" not in w and "/radius: took 0.25 from '0.25m'" in w]) == 1
+
+
 def test_bad_numbers_name_the_element(tmp_path):
     path = world_file(tmp_path, box_model("m", size="1 two 3"))
     with pytest.raises(ModelError) as err:

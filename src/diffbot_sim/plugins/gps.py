@@ -24,7 +24,8 @@ from sensor_msgs.msg import NavSatFix
 
 from .. import noise, ros_msgs
 from ..config import _bool, _number
-from ..errors import ModelError
+from ..errors import ModelError, PluginNotLoaded
+from ..tag_values import tag_number
 from .base import Plugin, join
 from .imu import read_tags
 
@@ -65,13 +66,16 @@ def to_geodetic(position, reference):
     return (lat0 + math.degrees(north / r_north), lon0 - math.degrees(west / r_east), alt0 + position[2])
 
 
-def settings(tags, where, root, generator):
-    """Everything the plugin does, from its tags (pure)."""
-    values = {key: _number(f"<{key}> of {where}", tags.get(key, default)) for key, default in DEFAULTS.items()}
-    rate = _number(f"<updateRate> of {where}", tags.get("updateRate", 0.0), low=0.0)
+def settings(tags, where, root, generator, notes=None):
+    """Everything the plugin does, from its tags (pure); numbers read as Gazebo reads them, what it drops
+    after a number named in ``notes``."""
+    notes = notes if notes is not None else []
+    values = {key: tag_number(f"<{key}> of {where}", tags.get(key, default), notes)
+              for key, default in DEFAULTS.items()}
+    rate = tag_number(f"<updateRate> of {where}", tags.get("updateRate", 0.0), notes, low=0.0)
     period = 1.0 / rate if rate > 0 else 0.0
     if "updatePeriod" in tags:
-        period = _number(f"<updatePeriod> of {where}", tags["updatePeriod"], low=0.0)
+        period = tag_number(f"<updatePeriod> of {where}", tags["updatePeriod"], notes, low=0.0)
     out = {
         "body": tags.get("bodyName") or root,
         "frame": tags.get("frameId", "world"),
@@ -80,8 +84,8 @@ def settings(tags, where, root, generator):
         "namespace": tags.get("robotNamespace"),
         "reference": (values["referenceLatitude"], values["referenceLongitude"], values["referenceHeading"],
                       values["referenceAltitude"]),
-        "status": int(_number(f"<status> of {where}", tags.get("status", 0), low=-1, high=2)),
-        "service": int(_number(f"<service> of {where}", tags.get("service", 1), low=0, high=15)),
+        "status": tag_number(f"<status> of {where}", tags.get("status", 0), notes, integer=True, low=-1, high=2),
+        "service": tag_number(f"<service> of {where}", tags.get("service", 1), notes, integer=True, low=0, high=15),
         "period": period,
         "position": noise.hector_models(tags, "", generator, where),
         "velocity": noise.hector_models(tags, "velocity", generator, where),
@@ -104,8 +108,8 @@ class Gps(Plugin):
         try:
             ctx.robot.link_motion(values["body"])
         except KeyError:
-            raise ModelError(f"GPS: bodyName '{values['body']}' is not a link of the model", ctx.model.source,
-                             path) from None
+            raise PluginNotLoaded(f"GPS: bodyName '{values['body']}' is not a link of the model; the plugin is "
+                                  "not loaded, as in Gazebo", ctx.model.source, path) from None
         ns = ctx.plugin_namespace(values["namespace"])
         self.fix_pub = ctx.publisher(join(ns, values["topic"]), NavSatFix)
         self.vel_pub = ctx.publisher(join(ns, values["velocity_topic"]), Vector3Stamped)
@@ -158,7 +162,7 @@ def create(ctx, element, path, params):
     tags = read_tags(element)
     generator = noise.rng(ctx.cfg.seed, element.get("name") or path)
     try:
-        values = settings(tags, path, ctx.model.root, generator)
+        values = settings(tags, path, ctx.model.root, generator, ctx.warnings)
     except ModelError as err:
         raise ModelError(str(err), ctx.model.source) from None
     if values["world_coordinates"]:

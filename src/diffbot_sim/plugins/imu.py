@@ -38,9 +38,10 @@ from sensor_msgs.msg import Imu
 
 from .. import noise, ros_msgs
 from ..config import _bool, _number
-from ..transforms import qconj, qmul
-from ..errors import ConfigError, ModelError
+from ..errors import ConfigError, ModelError, PluginNotLoaded
 from ..model import tag_value
+from ..tag_values import tag_number
+from ..transforms import qconj, qmul
 from .base import Plugin, join
 
 SENSOR_FILENAME = "libgazebo_ros_imu_sensor.so"
@@ -97,15 +98,20 @@ def sensor_pose(element, where):
     return values[:3], quaternion_from_rpy(*values[3:])
 
 
-def update_rate(element, where):
-    """The SDF ``<update_rate>`` [Hz] of a sensor (0: every step)."""
+def update_rate(element, where, notes=None):
+    """The SDF ``<update_rate>`` [Hz] of a sensor (0: every step), read as Gazebo reads it."""
     child = element.find("update_rate") if element is not None else None
     if child is None:
         return 0.0
-    return _number(f"<update_rate> of {where}", tag_value(child), low=0.0)
+    return tag_number(f"<update_rate> of {where}", tag_value(child), _notes(notes), low=0.0)
 
 
-def sdf_imu_noise(element, generator, where):
+def _notes(notes):
+    """Where the notes of a lenient reading go (a throw-away list when the caller keeps none)."""
+    return notes if notes is not None else []
+
+
+def sdf_imu_noise(element, generator, where, notes=None):
     """Per-axis SDF noise of an ``<imu>`` block: ([rate x, y, z], [accel x, y, z]) of Gaussian or None."""
     imu = element.find("imu") if element is not None else None
     rate, accel = [None] * 3, [None] * 3
@@ -120,7 +126,7 @@ def sdf_imu_noise(element, generator, where):
                 if kind is not None and block.find("type") is None:
                     block = _with_type(block, (kind.text or "").strip())
                 for i in range(3):
-                    out[i] = noise.sdf_noise(block, generator, f"{where}/imu/noise/{key}")
+                    out[i] = noise.sdf_noise(block, generator, f"{where}/imu/noise/{key}", notes)
     for key, out in (("angular_velocity", rate), ("linear_acceleration", accel)):
         block = imu.find(key)
         if block is None:
@@ -128,7 +134,7 @@ def sdf_imu_noise(element, generator, where):
         for i, axis in enumerate("xyz"):
             el = block.find(axis)
             if el is not None:
-                out[i] = noise.sdf_noise(el.find("noise"), generator, f"{where}/imu/{key}/{axis}/noise")
+                out[i] = noise.sdf_noise(el.find("noise"), generator, f"{where}/imu/{key}/{axis}/noise", notes)
     return rate, accel
 
 
@@ -165,14 +171,16 @@ class ImuSettings:
         self.__dict__.update(values)
 
 
-def sensor_settings(sensor, plugin, seed, where):
-    """ImuSettings of ``<sensor type="imu">`` + libgazebo_ros_imu_sensor.so (``plugin`` element)."""
+def sensor_settings(sensor, plugin, seed, where, notes=None):
+    """ImuSettings of ``<sensor type="imu">`` + libgazebo_ros_imu_sensor.so (``plugin`` element); what Gazebo
+    drops after a number is named in ``notes``."""
+    notes = _notes(notes)
     tags = read_tags(plugin)
     if sensor.link is None:
         raise ModelError("an imu sensor must sit in a <gazebo reference=\"LINK\"> block", None, where)
     generator = noise.rng(seed, sensor.name or sensor.link)
-    rate_noise, accel_noise = sdf_imu_noise(sensor.element, generator, where)
-    sdf_rate = update_rate(sensor.element, where)
+    rate_noise, accel_noise = sdf_imu_noise(sensor.element, generator, where, notes)
+    sdf_rate = update_rate(sensor.element, where, notes)
     s = ImuSettings(link=sensor.link, sdf_rate=rate_noise, sdf_accel=accel_noise,
                     mount=sensor_pose(sensor.element, where))
     s.unknown = []
@@ -209,14 +217,14 @@ def sensor_settings(sensor, plugin, seed, where):
         s.topic = tags.get("topicName", "imu_data")
         s.frame = tags["frameName"]
         if "updateRateHZ" in tags:
-            hz = _number(f"<updateRateHZ> of {where}", tags["updateRateHZ"], low=0.0)
+            hz = tag_number(f"<updateRateHZ> of {where}", tags["updateRateHZ"], notes, low=0.0)
         else:
             hz = 1.0
             s.unknown.append("no <updateRateHZ>: 1 Hz, as the original (which warns too)")
         if sdf_rate > 0:
             hz = min(hz, sdf_rate) if hz > 0 else sdf_rate
         s.period = 1.0 / hz if hz > 0 else 0.0
-        s.gaussian_noise = _number(f"<gaussianNoise> of {where}", tags.get("gaussianNoise", 0.0), low=0.0)
+        s.gaussian_noise = tag_number(f"<gaussianNoise> of {where}", tags.get("gaussianNoise", 0.0), notes, low=0.0)
         s.orientation_noise = True
         if "rpyOffset" in tags:
             s.rpy_offset = vector(tags["rpyOffset"], where, "rpyOffset")
@@ -232,13 +240,14 @@ def sensor_settings(sensor, plugin, seed, where):
     return s
 
 
-def model_settings(element, seed, where, name):
+def model_settings(element, seed, where, name, notes=None):
     """ImuSettings of the model plugin libgazebo_ros_imu.so."""
+    notes = _notes(notes)
     tags = read_tags(element)
     if "bodyName" not in tags:
         raise ModelError("libgazebo_ros_imu.so needs <bodyName> (it refuses to load without it)", None, where)
-    gn = _number(f"<gaussianNoise> of {where}", tags.get("gaussianNoise", 0.0), low=0.0)
-    rate = _number(f"<updateRate> of {where}", tags.get("updateRate", 0.0), low=0.0)
+    gn = tag_number(f"<gaussianNoise> of {where}", tags.get("gaussianNoise", 0.0), notes, low=0.0)
+    rate = tag_number(f"<updateRate> of {where}", tags.get("updateRate", 0.0), notes, low=0.0)
     s = ImuSettings(link=tags["bodyName"], frame=tags.get("frameName") or tags["bodyName"],
                     topic=tags.get("topicName", "/default_imu"), namespace=tags.get("robotNamespace"),
                     period=1.0 / rate if rate > 0 else 0.0, gaussian_noise=gn, covariance=(gn ** 2,) * 3,
@@ -256,21 +265,22 @@ def model_settings(element, seed, where, name):
     return s
 
 
-def hector_settings(element, seed, where, name, root):
+def hector_settings(element, seed, where, name, root, notes=None):
     """ImuSettings of libhector_gazebo_ros_imu.so (``root``: the model's first link, hector's default)."""
+    notes = _notes(notes)
     tags = read_tags(element)
     generator = noise.rng(seed, name)
     link = tags.get("bodyName") or root
     topic = tags.get("topicName", "imu")
-    rate = _number(f"<updateRate> of {where}", tags.get("updateRate", 0.0), low=0.0)
+    rate = tag_number(f"<updateRate> of {where}", tags.get("updateRate", 0.0), notes, low=0.0)
     period = 1.0 / rate if rate > 0 else 0.0
     if "updatePeriod" in tags:
-        period = _number(f"<updatePeriod> of {where}", tags["updatePeriod"], low=0.0)
+        period = tag_number(f"<updatePeriod> of {where}", tags["updatePeriod"], notes, low=0.0)
     models = {"accel": noise.hector_models(tags, "accel", generator, where),
               "rate": noise.hector_models(tags, "rate", generator, where),
               "yaw": noise.hector_models(tags, "yaw", generator, where, axes=1)}
     if "gaussianNoise" in tags:
-        gn = _number(f"<gaussianNoise> of {where}", tags["gaussianNoise"], low=0.0)
+        gn = tag_number(f"<gaussianNoise> of {where}", tags["gaussianNoise"], notes, low=0.0)
         if gn != 0.0:
             for model in models["accel"] + models["rate"]:
                 model.gaussian_noise = gn
@@ -375,8 +385,8 @@ class ImuPlugin(Plugin):
         try:
             ctx.robot.link_motion(settings.link)
         except KeyError:
-            raise ModelError(f"IMU link '{settings.link}' is not a link of the model", ctx.model.source,
-                             path) from None
+            raise PluginNotLoaded(f"IMU link '{settings.link}' is not a link of the model; the plugin is not "
+                                  "loaded, as in Gazebo", ctx.model.source, path) from None
         self.reading = Reading(settings, getattr(ctx.robot, "gravity", -9.81))
         ns = ctx.plugin_namespace(settings.namespace)
         self.pub = ctx.publisher(join(ns, settings.topic), Imu)
@@ -438,19 +448,19 @@ def _wrap(ctx, fn, *args):
 
 def create_sensor(ctx, sensor, plugin, params):
     """``<sensor type="imu">`` + libgazebo_ros_imu_sensor.so."""
-    settings = _wrap(ctx, sensor_settings, sensor, plugin, ctx.cfg.seed, sensor.path)
+    settings = _wrap(ctx, sensor_settings, sensor, plugin, ctx.cfg.seed, sensor.path, ctx.warnings)
     return ImuPlugin(ctx, settings, SENSOR_FILENAME, sensor.path)
 
 
 def create_model(ctx, element, path, params):
     """The model plugin libgazebo_ros_imu.so."""
-    settings = _wrap(ctx, model_settings, element, ctx.cfg.seed, path, element.get("name") or path)
+    settings = _wrap(ctx, model_settings, element, ctx.cfg.seed, path, element.get("name") or path, ctx.warnings)
     return ImuPlugin(ctx, settings, MODEL_FILENAME, path)
 
 
 def create_hector(ctx, element, path, params):
     """The model plugin libhector_gazebo_ros_imu.so."""
     settings = _wrap(ctx, hector_settings, element, ctx.cfg.seed, path, element.get("name") or path,
-                     ctx.model.root)
+                     ctx.model.root, ctx.warnings)
     return ImuPlugin(ctx, settings, HECTOR_FILENAME, path)
 

@@ -41,7 +41,7 @@ class JointStatePublisher(Plugin):
 
 def create(ctx, block, drive):
     """From the plugin block (may be None) and the drive (its publishWheelJointState); None if no joints."""
-    cfg = cfgmod.joint_state_config(ctx.model, block, drive)
+    cfg = cfgmod.joint_state_config(ctx.model, block, drive, ctx.warnings)
     if cfg is None:
         return None
     if ctx.namespace:

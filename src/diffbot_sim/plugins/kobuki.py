@@ -28,6 +28,7 @@ from ..config import _bool, _number, _string
 from ..errors import ModelError
 from ..kinematics import quaternion_from_yaw, wheel_speeds
 from ..model import tag_value
+from ..tag_values import tag_number
 from .base import Plugin, finite_twist, join
 from .joint_motors import UNLIMITED_EFFORT
 
@@ -183,17 +184,19 @@ def create(ctx, element, path, params):
     if missing:
         raise ModelError(f"the Kobuki plugin needs <{missing[0]}> (it refuses to load without it)",
                          ctx.model.source, path)
+    notes = ctx.warnings
     values = {
         "left_wheel_joint_name": _string(f"<left_wheel_joint_name> of {path}", tags["left_wheel_joint_name"]),
         "right_wheel_joint_name": _string(f"<right_wheel_joint_name> of {path}", tags["right_wheel_joint_name"]),
-        "wheel_separation": _number(f"<wheel_separation> of {path}", tags["wheel_separation"], low=0.0,
-                                    low_open=True),
-        "wheel_diameter": _number(f"<wheel_diameter> of {path}", tags["wheel_diameter"], low=0.0, low_open=True),
-        "torque": _number(f"<torque> of {path}", tags["torque"], low=0.0),
-        "velocity_command_timeout": _number(f"<velocity_command_timeout> of {path}",
-                                            tags["velocity_command_timeout"], low=0.0),
+        "wheel_separation": tag_number(f"<wheel_separation> of {path}", tags["wheel_separation"], notes,
+                                       low=0.0, low_open=True),
+        "wheel_diameter": tag_number(f"<wheel_diameter> of {path}", tags["wheel_diameter"], notes, low=0.0,
+                                     low_open=True),
+        "torque": tag_number(f"<torque> of {path}", tags["torque"], notes, low=0.0),
+        "velocity_command_timeout": tag_number(f"<velocity_command_timeout> of {path}",
+                                               tags["velocity_command_timeout"], notes, low=0.0),
         "publish_tf": _bool(f"<publish_tf> of {path}", tags.get("publish_tf", "false")),
-        "update_rate": _number(f"<update_rate> of {path}", tags.get("update_rate", 50.0), low=0.0),
+        "update_rate": tag_number(f"<update_rate> of {path}", tags.get("update_rate", 50.0), notes, low=0.0),
     }
     unknown = sorted(set(tags) - set(REQUIRED) - set(ACCEPTED))
     if unknown:

@@ -26,6 +26,7 @@ from .. import ray_sensor, ros_msgs
 from ..config import _number, _string
 from ..errors import ConfigError
 from ..model import tag_value
+from ..tag_values import tag_number
 from .base import Plugin, join
 
 ROS1_LASERS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so")
@@ -220,7 +221,7 @@ def _ros2(ctx, sensor, element, path):
         raise ConfigError(f"<output_type> of {path}", output, ", ".join(OUTPUT_TYPES))
     frame = values.get("frame_name", "").strip() or sensor.link or "world"
     frame = ctx.frame(ctx.clean_frame(frame, path))
-    min_intensity = (_number(f"<min_intensity> of {path}", values["min_intensity"])
+    min_intensity = (tag_number(f"<min_intensity> of {path}", values["min_intensity"], ctx.warnings)
                      if "min_intensity" in values else 0.0)
     radiation = values.get("radiation_type", "infrared").strip().lower()
     if radiation not in ("infrared", "ultrasound"):

@@ -13,7 +13,8 @@ from nav_msgs.msg import Odometry
 
 from .. import noise, ros_msgs
 from ..config import _number
-from ..errors import ModelError
+from ..errors import ModelError, PluginNotLoaded
+from ..tag_values import tag_number
 from .base import Plugin, join
 from .imu import qconj, qmul, qnormalize, qrotate, quaternion_from_rpy, read_tags, vector
 
@@ -23,17 +24,19 @@ KNOWN = {"bodyName", "topicName", "frameName", "xyzOffset", "xyzOffsets", "rpyOf
          "gaussianNoise", "updateRate", "robotNamespace", "alwaysOn"}
 
 
-def settings(tags, where):
+def settings(tags, where, notes=None):
     """{body, topic, frame, xyz, rpy, gaussian_noise, period} from the plugin's tags (pure)."""
     for tag in ("bodyName", "topicName"):
         if not tags.get(tag):
             raise ModelError(f"the p3d plugin needs <{tag}> (it refuses to load without it)", None, where)
-    rate = _number(f"<updateRate> of {where}", tags.get("updateRate", 0.0), low=0.0)
+    notes = notes if notes is not None else []
+    rate = tag_number(f"<updateRate> of {where}", tags.get("updateRate", 0.0), notes, low=0.0)
     xyz = next((vector(tags[t], where, t) for t in ("xyzOffset", "xyzOffsets") if t in tags), (0.0, 0.0, 0.0))
     rpy = next((vector(tags[t], where, t) for t in ("rpyOffset", "rpyOffsets") if t in tags), (0.0, 0.0, 0.0))
     return {"body": tags["bodyName"], "topic": tags["topicName"], "frame": tags.get("frameName", "world"),
             "xyz": xyz, "rpy": rpy, "namespace": tags.get("robotNamespace"),
-            "gaussian_noise": _number(f"<gaussianNoise> of {where}", tags.get("gaussianNoise", 0.0), low=0.0),
+            "gaussian_noise": tag_number(f"<gaussianNoise> of {where}", tags.get("gaussianNoise", 0.0), notes,
+                                         low=0.0),
             "period": 1.0 / rate if rate > 0 else 0.0}
 
 
@@ -61,7 +64,8 @@ class P3D(Plugin):
             try:
                 ctx.robot.link_motion(link)
             except KeyError:
-                raise ModelError(f"p3d: '{link}' is not a link of the model", ctx.model.source, path) from None
+                raise PluginNotLoaded(f"p3d: '{link}' is not a link of the model; the plugin is not loaded, as in "
+                                      "Gazebo", ctx.model.source, path) from None
         self.offset_rot = quaternion_from_rpy(*values["rpy"])
         ns = ctx.plugin_namespace(values["namespace"])
         self.pub = ctx.publisher(join(ns, values["topic"]), Odometry)
@@ -107,7 +111,7 @@ class P3D(Plugin):
 def create(ctx, element, path, params):
     tags = read_tags(element)
     try:
-        values = settings(tags, path)
+        values = settings(tags, path, ctx.warnings)
     except ModelError as err:
         raise ModelError(str(err), ctx.model.source) from None
     unknown = sorted(set(tags) - KNOWN)

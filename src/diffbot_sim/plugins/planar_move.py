@@ -14,6 +14,7 @@ from nav_msgs.msg import Odometry
 from .. import ros_msgs
 from ..config import _bool, _number, _string
 from ..model import tag_value
+from ..tag_values import tag_number
 from .base import Plugin, finite_twist, join
 
 DEFAULTS = {"commandTopic": "cmd_vel", "odometryTopic": "odom", "odometryFrame": "odom",
@@ -100,9 +101,9 @@ def create(ctx, element, path, params):
         text = tag_value(child)
         label = f"<{child.tag}> of {path}"
         if child.tag in ("odometryRate",):
-            values[child.tag] = _number(label, text, low=0.0)
+            values[child.tag] = tag_number(label, text, ctx.warnings, low=0.0)
         elif child.tag == "cmdTimeout":
-            values[child.tag] = _number(label, text)
+            values[child.tag] = tag_number(label, text, ctx.warnings)
         elif child.tag == "publishOdometryTf":
             values[child.tag] = _bool(label, text)
         elif child.tag in DEFAULTS:

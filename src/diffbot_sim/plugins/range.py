@@ -15,6 +15,7 @@ from sensor_msgs.msg import Range as RangeMsg
 
 from .. import ray_sensor, ros_msgs
 from ..config import _number, _string
+from ..tag_values import tag_number
 from .base import join
 from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
 
@@ -60,8 +61,9 @@ def create(ctx, sensor, element, params):
     topic = _string(f"<topicName> of {path}", values["topicName"]) if "topicName" in values else "/range"
     frame = ros1_frame(ctx, values, sensor, path)
     ultrasound = values.get("radiation", "ultrasound").strip() == "ultrasound"
-    fov = _number(f"<fov> of {path}", values["fov"], low=0.0) if "fov" in values else 0.05
-    stddev = _number(f"<gaussianNoise> of {path}", values["gaussianNoise"], low=0.0) \
+    fov = tag_number(f"<fov> of {path}", values["fov"], ctx.warnings, low=0.0) if "fov" in values else 0.05
+    stddev = tag_number(f"<gaussianNoise> of {path}", values["gaussianNoise"], ctx.warnings, low=0.0) \
         if "gaussianNoise" in values else 0.0
-    rate = _number(f"<updateRate> of {path}", values["updateRate"], low=0.0) if "updateRate" in values else 0.0
+    rate = tag_number(f"<updateRate> of {path}", values["updateRate"], ctx.warnings, low=0.0) \
+        if "updateRate" in values else 0.0
     return RangeSensor(ctx, sensor, element, path, join(ns, topic), frame, ultrasound, fov, stddev, rate)

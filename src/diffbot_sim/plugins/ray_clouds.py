@@ -17,6 +17,7 @@ import numpy as np
 
 from .. import ros_msgs
 from ..config import _bool, _number
+from ..tag_values import tag_number
 from .base import join
 from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
 from sensor_msgs.msg import PointCloud, PointCloud2
@@ -47,7 +48,8 @@ class BlockLaser(RaySensorPlugin):
         super().__init__(ctx, sensor, element, path)
         ns = ros1_namespace(ctx, values)
         self.frame = ros1_frame(ctx, values, sensor, path, warn=False)
-        self.noise = _number(f"<gaussianNoise> of {path}", values.get("gaussianNoise", 0.0), low=0.0)
+        self.noise = tag_number(f"<gaussianNoise> of {path}", values.get("gaussianNoise", 0.0), ctx.warnings,
+                                low=0.0)
         self.pub = ctx.publisher(join(ns, values.get("topicName") or "/world"), PointCloud)
         self.azimuth, self.inclination = _angles(self.cfg)
 
@@ -73,11 +75,13 @@ class VelodyneLaser(RaySensorPlugin):
         ns = ros1_namespace(ctx, values)
         label = lambda tag: f"<{tag}> of {path}"  # noqa: E731
         self.frame = ros1_frame(ctx, values, sensor, path, warn=False)
-        self.min_range = _number(label("min_range"), values.get("min_range", 0.9), low=0.0)
-        self.max_range = _number(label("max_range"), values.get("max_range", 130.0), low=0.0, low_open=True)
-        self.noise = _number(label("gaussianNoise"), values.get("gaussianNoise", 0.0), low=0.0)
+        notes = ctx.warnings
+        self.min_range = tag_number(label("min_range"), values.get("min_range", 0.9), notes, low=0.0)
+        self.max_range = tag_number(label("max_range"), values.get("max_range", 130.0), notes, low=0.0,
+                                    low_open=True)
+        self.noise = tag_number(label("gaussianNoise"), values.get("gaussianNoise", 0.0), notes, low=0.0)
         self.organize = _bool(label("organize_cloud"), values.get("organize_cloud", "false"))
-        self.min_intensity = _number(label("min_intensity"), values.get("min_intensity", 0.0))
+        self.min_intensity = tag_number(label("min_intensity"), values.get("min_intensity", 0.0), notes)
         self.pub = ctx.publisher(join(ns, values.get("topicName") or "/velodyne_points"), PointCloud2)
         self.builder = ros_msgs.RingCloudBuilder(self.frame)
         self.azimuth, self.inclination = _angles(self.cfg)

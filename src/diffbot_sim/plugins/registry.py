@@ -10,6 +10,7 @@ from .ground_truth import GroundTruth
 from .joint_motors import JointMotors
 from .laser import create_laser, create_ray_sensor
 from .range import create as create_range
+from ..errors import PluginNotLoaded
 from .tags import DIFF_DRIVE, JOINT_STATE, plugin_filename
 
 #: Model plugins by filename (``libNAME.so``).
@@ -42,6 +43,14 @@ KNOWN = (DIFF_DRIVE, JOINT_STATE) + tuple(MODEL_PLUGINS)
 KNOWN_SENSORS = tuple(SENSOR_PLUGINS)
 
 
+def _add(ctx, plugins, factory, *args):
+    """Build one plugin into ``plugins``; one Gazebo would not load (PluginNotLoaded) is one warning."""
+    try:
+        plugins.append(factory(ctx, *args))
+    except PluginNotLoaded as err:
+        ctx.warnings.append(str(err))
+
+
 def build(ctx, found, params):
     """Every plugin of one robot, in model order, plus the transmission motors no plugin owns and the
     optional ground truth. ``found`` is the model's :class:`~diffbot_sim.plugins.tags.Plugins`.
@@ -56,12 +65,12 @@ def build(ctx, found, params):
     for item in found.others:
         factory = MODEL_PLUGINS.get(item.filename)
         if factory is not None:
-            plugins.append(factory(ctx, item.element, item.path, params))
+            _add(ctx, plugins, factory, item.element, item.path, params)
     for sensor in found.sensors:  # a sensor is simulated by its first plugin that a module handles
         for plugin in sensor.element.findall("plugin"):
             factory = SENSOR_PLUGINS.get(plugin_filename(plugin.get("filename")))
             if factory is not None:
-                plugins.append(factory(ctx, sensor, plugin, params))
+                _add(ctx, plugins, factory, sensor, plugin, params)
                 break
     js = joint_state.create(ctx, found.joint_state, drive.drive if drive is not None else None)
     if js is not None:

@@ -37,6 +37,7 @@ from ..config import _number, _string
 from ..errors import ConfigError, ModelError
 from ..kinematics import quaternion_from_yaw
 from ..model import tag_value
+from ..tag_values import tag_number
 from .base import Plugin, get_param, join, next_due
 from .joint_motors import effort_limit
 
@@ -483,7 +484,8 @@ def create(ctx, element, path, params):
         ctx.warnings.append(f"{path}: robotSimType '{sim_type}' is not simulated; using {DEFAULT_SIM_TYPE}")
     period = CONTROL_PERIOD
     if tags.get("controlPeriod"):
-        period = _number(f"<controlPeriod> of {path}", tags["controlPeriod"], low=0.0, low_open=True)
+        period = tag_number(f"<controlPeriod> of {path}", tags["controlPeriod"], ctx.warnings, low=0.0,
+                            low_open=True)
         period = max(period, ctx.cfg.time_step)
     hw = RosControl(ctx, path, ns, period, tags.get("eStopTopic"), sim_type)
     if ctx.cfg.autostart_controllers:

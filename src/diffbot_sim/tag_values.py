@@ -1,0 +1,65 @@
+"""Numbers in Gazebo tags, read as Gazebo reads them (pure).
+
+Gazebo reads every value of an SDF world and of a URDF's ``<gazebo>`` extension blocks (surface tags such as
+``<mu1>``, sensor elements such as ``<samples>``, plugin tags such as ``<updateRate>``) with C++'s leniency:
+sdformat's Param parses a double with ``std::stod`` and an unsigned int with ``std::stoul``, and plugins read
+their tags through ``sdf::Element::Get<T>``, a stringstream ``>>``. All of them skip leading white space, take
+the *leading* number and ignore the rest: a xacro-computed ``<samples>666.5185185185185</samples>`` is 666
+beams (a published robot has it), ``<updateRate>50.0Hz</updateRate>`` is 50. A text without a leading number
+is an error there, and here.
+
+The URDF itself (``<origin xyz>``, ``<mass value>``, ``<limit effort>``) is read by urdfdom, strictly: not
+here. Vectors (``<pose>``, noise vectors) are read strictly too: a stream of several numbers has no single
+"leading number", and published models write them cleanly.
+"""
+import re
+
+from .errors import ConfigError
+
+# std::stod: decimal with optional exponent, or inf/infinity/nan (any case), after optional white space.
+_DOUBLE = re.compile(r"\s*([+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan))", re.IGNORECASE)
+# std::stoul / std::stoi in base 10: digits after an optional sign.
+_INTEGER = re.compile(r"\s*([+-]?\d+)")
+
+
+def leading_number(text, integer=False):
+    """``(value, rest)``: the number ``text`` starts with, as ``std::stod`` (``integer``: ``std::stoi`` /
+    ``std::stoul``) takes it, and what follows it (stripped; "" when nothing does).
+
+    Raises:
+        ValueError: ``text`` does not start with a number.
+    """
+    match = (_INTEGER if integer else _DOUBLE).match(text)
+    if match is None:
+        raise ValueError(f"no leading number in {text!r}")
+    token = match.group(1)
+    value = int(token) if integer else float(token)
+    return value, text[match.end():].strip()
+
+
+def tag_number(label, text, notes, integer=False, **limits):
+    """The number in a Gazebo tag's ``text``, read as Gazebo does (:func:`leading_number`), then held to
+    ``limits`` (``low``, ``high``, ``low_open``: see :func:`diffbot_sim.config._number`). What Gazebo drops
+    after the number is dropped here too, with one line in ``notes`` naming ``label``. A value that is not
+    text (a default, or a number already) is only checked against the limits.
+
+    Raises:
+        ConfigError: no leading number (naming ``label``), or a value out of ``limits``.
+    """
+    from .config import _number
+
+    if not isinstance(text, str):
+        number = _number(label, text, **limits)
+        return int(number) if integer else number
+    try:
+        value, rest = leading_number(text, integer)
+    except ValueError:
+        raise ConfigError(label, text, "a whole number" if integer else "a number") from None
+    try:
+        number = _number(label, value, **limits)
+    except ConfigError as err:
+        raise ConfigError(label, text, err.expected) from None  # the text as written, not the number read
+    if rest:
+        reader = "std::stoul" if integer else "std::stod"
+        notes.append(f"{label}: took {value:g} from '{text.strip()}', as Gazebo's SDF reader ({reader}) does")
+    return int(number) if integer else number
