@@ -19,7 +19,7 @@ from sensor_msgs.msg import CameraInfo, Image
 
 from .. import camera_sensor as cam
 from .. import ros_msgs
-from ..errors import ModelError
+from ..errors import PluginNotLoaded
 from .base import Plugin, join
 
 def choose_renderer(ctx):
@@ -40,8 +40,9 @@ class CameraBase(Plugin):
         try:
             ctx.robot.link_pose(self.link)
         except KeyError:
-            raise ModelError(f"camera sensor '{cfg.name}' is on link '{self.link}', which the model does not "
-                             "have", ctx.model.source, sensor.path) from None
+            raise PluginNotLoaded(f"camera sensor '{cfg.name}' is on link '{self.link}', which the model does not "
+                                  "have; the plugin is not loaded, as in Gazebo", ctx.model.source,
+                                  sensor.path) from None
         values = tags.values
         self.intrinsics = cam.intrinsics(
             cfg.width, cfg.height, cfg.hfov, cx=values.get("cx", 0.0), cy=values.get("cy", 0.0),

@@ -23,7 +23,7 @@ from geometry_msgs.msg import Vector3Stamped
 from sensor_msgs.msg import NavSatFix
 
 from .. import noise, ros_msgs
-from ..config import _bool, _number
+from ..config import _bool
 from ..errors import ModelError, PluginNotLoaded
 from ..tag_values import tag_number
 from .base import Plugin, join
@@ -164,7 +164,7 @@ def create(ctx, element, path, params):
     try:
         values = settings(tags, path, ctx.model.root, generator, ctx.warnings)
     except ModelError as err:
-        raise ModelError(str(err), ctx.model.source) from None
+        raise type(err)(str(err), ctx.model.source) from None
     if values["world_coordinates"]:
         ctx.warnings.append(f"{path}: <useWorldSphericalCoordinates> ignored (no world spherical coordinates "
                             "here); using the reference tags")

@@ -37,7 +37,7 @@ import xml.etree.ElementTree as ET
 from sensor_msgs.msg import Imu
 
 from .. import noise, ros_msgs
-from ..config import _bool, _number
+from ..config import _bool
 from ..errors import ConfigError, ModelError, PluginNotLoaded
 from ..model import tag_value
 from ..tag_values import tag_number
@@ -211,7 +211,7 @@ def sensor_settings(sensor, plugin, seed, where, notes=None):
         known = set(_ROS2_TAGS)
     else:
         if "frameName" not in tags:
-            raise ModelError("the IMU sensor plugin needs <frameName> (it refuses to load without it)", None,
+            raise PluginNotLoaded("the IMU sensor plugin needs <frameName> (it refuses to load without it)", None,
                              where)
         s.namespace = tags.get("robotNamespace")
         s.topic = tags.get("topicName", "imu_data")
@@ -245,7 +245,7 @@ def model_settings(element, seed, where, name, notes=None):
     notes = _notes(notes)
     tags = read_tags(element)
     if "bodyName" not in tags:
-        raise ModelError("libgazebo_ros_imu.so needs <bodyName> (it refuses to load without it)", None, where)
+        raise PluginNotLoaded("libgazebo_ros_imu.so needs <bodyName> (it refuses to load without it)", None, where)
     gn = tag_number(f"<gaussianNoise> of {where}", tags.get("gaussianNoise", 0.0), notes, low=0.0)
     rate = tag_number(f"<updateRate> of {where}", tags.get("updateRate", 0.0), notes, low=0.0)
     s = ImuSettings(link=tags["bodyName"], frame=tags.get("frameName") or tags["bodyName"],
@@ -442,7 +442,7 @@ def _wrap(ctx, fn, *args):
         return fn(*args)
     except ModelError as err:
         if err.source is None:
-            raise ModelError(str(err), ctx.model.source) from None
+            raise type(err)(str(err), ctx.model.source) from None  # PluginNotLoaded stays what it is
         raise
 
 

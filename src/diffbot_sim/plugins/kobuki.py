@@ -24,7 +24,7 @@ from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import Empty
 
 from .. import ros_msgs
-from ..config import _bool, _number, _string
+from ..config import _bool, _string
 from ..errors import ModelError
 from ..kinematics import quaternion_from_yaw, wheel_speeds
 from ..model import tag_value

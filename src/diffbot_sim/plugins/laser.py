@@ -23,7 +23,7 @@ casting is ``World.ray_batch``. As gazebo_ros does:
 from sensor_msgs.msg import LaserScan, PointCloud, PointCloud2, Range
 
 from .. import ray_sensor, ros_msgs
-from ..config import _number, _string
+from ..config import _string
 from ..errors import ConfigError
 from ..model import tag_value
 from ..tag_values import tag_number

@@ -12,7 +12,6 @@ here a lumped link works too.
 from nav_msgs.msg import Odometry
 
 from .. import noise, ros_msgs
-from ..config import _number
 from ..errors import ModelError, PluginNotLoaded
 from ..tag_values import tag_number
 from .base import Plugin, join
@@ -28,7 +27,7 @@ def settings(tags, where, notes=None):
     """{body, topic, frame, xyz, rpy, gaussian_noise, period} from the plugin's tags (pure)."""
     for tag in ("bodyName", "topicName"):
         if not tags.get(tag):
-            raise ModelError(f"the p3d plugin needs <{tag}> (it refuses to load without it)", None, where)
+            raise PluginNotLoaded(f"the p3d plugin needs <{tag}> (it refuses to load without it)", None, where)
     notes = notes if notes is not None else []
     rate = tag_number(f"<updateRate> of {where}", tags.get("updateRate", 0.0), notes, low=0.0)
     xyz = next((vector(tags[t], where, t) for t in ("xyzOffset", "xyzOffsets") if t in tags), (0.0, 0.0, 0.0))
@@ -113,7 +112,7 @@ def create(ctx, element, path, params):
     try:
         values = settings(tags, path, ctx.warnings)
     except ModelError as err:
-        raise ModelError(str(err), ctx.model.source) from None
+        raise type(err)(str(err), ctx.model.source) from None  # PluginNotLoaded stays what it is
     unknown = sorted(set(tags) - KNOWN)
     if unknown:
         ctx.warnings.append(f"{path}: unknown tags ignored: {', '.join(unknown)}")

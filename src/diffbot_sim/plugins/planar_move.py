@@ -12,7 +12,7 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
 from .. import ros_msgs
-from ..config import _bool, _number, _string
+from ..config import _bool, _string
 from ..model import tag_value
 from ..tag_values import tag_number
 from .base import Plugin, finite_twist, join

@@ -14,7 +14,7 @@ warning; gazebo_ros says ``/world``); ``radiation`` (``ultrasound``, anything el
 from sensor_msgs.msg import Range as RangeMsg
 
 from .. import ray_sensor, ros_msgs
-from ..config import _number, _string
+from ..config import _string
 from ..tag_values import tag_number
 from .base import join
 from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace

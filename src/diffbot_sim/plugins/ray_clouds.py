@@ -16,7 +16,7 @@ sensor_msgs/PointCloud2 with x, y, z, intensity, ring, time). Casting and range 
 import numpy as np
 
 from .. import ros_msgs
-from ..config import _bool, _number
+from ..config import _bool
 from ..tag_values import tag_number
 from .base import join
 from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
