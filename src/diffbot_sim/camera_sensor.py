@@ -21,10 +21,10 @@ from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
-from .config import _number
-from .errors import ConfigError
-from .model import tag_value
-from .tag_values import tag_number
+from diffbot_sim.config import _number
+from diffbot_sim.errors import ConfigError
+from diffbot_sim.model import tag_value
+from diffbot_sim.tag_values import tag_number
 
 CAMERA_TYPES = ("camera", "depth")
 #: ``<image><format>`` -> ROS encoding (GazeboRosCameraUtils). Rendered here: these three.

@@ -9,8 +9,8 @@ import math
 from dataclasses import asdict, dataclass, field, fields
 from typing import List, Optional
 
-from .errors import ConfigError, ModelError
-from .tag_values import tag_number
+from diffbot_sim.errors import ConfigError, ModelError
+from diffbot_sim.tag_values import tag_number
 
 #: Wheel speed cap [rad/s] when neither ``~max_wheel_velocity`` nor the URDF ``<limit velocity>`` gives one:
 #: keeps a 1e308 command from reaching the physics as an absurd motor target.

@@ -11,10 +11,10 @@ import math
 from dataclasses import asdict, dataclass, field
 from typing import NamedTuple, Optional, Tuple
 
-from .errors import ConfigError
-from .kinematics import wheel_speeds
-from .limits import SpeedLimiter
-from .odometry import EncoderOdometry
+from diffbot_sim.errors import ConfigError
+from diffbot_sim.kinematics import wheel_speeds
+from diffbot_sim.limits import SpeedLimiter
+from diffbot_sim.odometry import EncoderOdometry
 
 CONTROLLER_TYPE = "diff_drive_controller/DiffDriveController"
 

@@ -7,8 +7,8 @@ lazily so the rest of the package stays importable without them.
 import os
 import xml.etree.ElementTree as ET
 
-from . import xacro_compat
-from .errors import ModelError
+from diffbot_sim import xacro_compat
+from diffbot_sim.errors import ModelError
 
 
 def parse_args(text):
@@ -131,7 +131,7 @@ def load_world(name, map_wall_height):
     """
     path = resolve_world_path(name)
     if path.endswith((".yaml", ".yml")):
-        from .world_map import read_map
+        from diffbot_sim.world_map import read_map
         return read_map(path, map_wall_height)
-    from .world_sdf import read_world, ros_package_model_paths
+    from diffbot_sim.world_sdf import read_world, ros_package_model_paths
     return read_world(path, package_model_paths=ros_package_model_paths())

@@ -34,7 +34,7 @@ from urllib.parse import urlsplit, urlunsplit
 
 import yaml
 
-from .errors import DiffbotSimError
+from diffbot_sim.errors import DiffbotSimError
 
 #: rosgraph.names.REMAP: an argument containing it is a ROS remapping, not the program's.
 REMAP = ":="

@@ -11,7 +11,7 @@ import math
 from dataclasses import dataclass, fields
 from typing import Mapping, NamedTuple, Optional
 
-from .errors import ConfigError
+from diffbot_sim.errors import ConfigError
 
 #: Ctrl-C as a byte: the terminal is put in a mode where it arrives as input, not as SIGINT.
 QUIT_KEY = "\x03"

@@ -29,7 +29,7 @@ from typing import Dict, List, Tuple
 
 import numpy as np
 
-from .transforms import rpy_matrix
+from diffbot_sim.transforms import rpy_matrix
 
 #: Mass [kg] of a root link left without any: PyBullet treats a base of mass 0 as fixed in the world.
 ROOT_PLACEHOLDER_MASS = 1e-6

@@ -37,7 +37,7 @@ from urllib.parse import unquote
 
 import numpy as np
 
-from .errors import ModelError
+from diffbot_sim.errors import ModelError
 
 #: Bump when the converter's output changes, so older cache entries are not used.
 CACHE_FORMAT = 1

@@ -21,8 +21,8 @@ import math
 import random
 import zlib
 
-from .errors import ConfigError, ModelError
-from .tag_values import tag_number
+from diffbot_sim.errors import ConfigError, ModelError
+from diffbot_sim.tag_values import tag_number
 
 SDF_KINDS = ("none", "gaussian", "gaussian_quantized")
 

@@ -7,7 +7,7 @@ gives negative linear velocity, unlike gazebo_ros_diff_drive's encoder mode, gaz
 import math
 from collections import deque
 
-from .errors import ConfigError
+from diffbot_sim.errors import ConfigError
 
 
 def integrate_exact(x, y, yaw, distance, dyaw):

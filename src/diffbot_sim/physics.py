@@ -9,8 +9,8 @@ import math
 import os
 import tempfile
 
-from . import lumping
-from .errors import ModelError
+from diffbot_sim import lumping
+from diffbot_sim.errors import ModelError
 
 #: Gazebo's friction coefficient for a surface that gives none (SDF <surface><friction><ode><mu> default).
 GAZEBO_DEFAULT_MU = 1.0
@@ -200,7 +200,7 @@ class World:
 
     def _compound(self, shapes, static, mesh_cache):
         """One collision shape index for a body's shapes (a compound when there are several)."""
-        from . import meshes  # pure; here only to convert world meshes
+        from diffbot_sim import meshes  # pure; here only to convert world meshes
 
         c = self.client
         concave = pybullet.GEOM_FORCE_CONCAVE_TRIMESH if static else 0
@@ -356,7 +356,7 @@ class World:
         TinyRenderer; "egl": the EGL plugin (``use_egl`` must have succeeded; else TinyRenderer draws)."""
         import numpy as np
 
-        from . import camera_sensor
+        from diffbot_sim import camera_sensor
         c = self.client
         eye, target, up = camera_sensor.look_at(view_pose)
         view = pybullet.computeViewMatrix(eye, target, up, physicsClientId=c)

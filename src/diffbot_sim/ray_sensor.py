@@ -22,11 +22,11 @@ from typing import List, Tuple
 
 import numpy as np
 
-from .config import _bool, _number
-from .errors import ConfigError
-from .tag_values import tag_number
-from .model import tag_value
-from .transforms import rpy_matrix
+from diffbot_sim.config import _bool, _number
+from diffbot_sim.errors import ConfigError
+from diffbot_sim.tag_values import tag_number
+from diffbot_sim.model import tag_value
+from diffbot_sim.transforms import rpy_matrix
 
 
 @dataclass

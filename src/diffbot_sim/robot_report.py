@@ -13,12 +13,12 @@ import os
 from dataclasses import dataclass, field
 from typing import List, Optional, Tuple
 
-from . import config as cfgmod
-from . import ddc, meshes
-from .controllers import find_controllers
-from .description import load_file, parse_args
-from .model import parse_urdf, tag_value
-from .plugins.tags import DIFF_DRIVE, JOINT_STATE, read_plugins
+from diffbot_sim import config as cfgmod
+from diffbot_sim import ddc, meshes
+from diffbot_sim.controllers import find_controllers
+from diffbot_sim.description import load_file, parse_args
+from diffbot_sim.model import parse_urdf, tag_value
+from diffbot_sim.plugins.tags import DIFF_DRIVE, JOINT_STATE, read_plugins
 
 SKID_STEER = "libgazebo_ros_skid_steer_drive.so"
 PLANAR_MOVE = "libgazebo_ros_planar_move.so"
@@ -131,8 +131,8 @@ def build_report(path, model_args="", controller_files=(), known=None, resolve_p
     """
     known_sensors = ()
     if known is None:
-        from .plugins.registry import KNOWN as known  # imports the plugin modules (and rospy) only here
-        from .plugins.registry import KNOWN_SENSORS as known_sensors
+        from diffbot_sim.plugins.registry import KNOWN as known  # imports the plugin modules (and rospy) only here
+        from diffbot_sim.plugins.registry import KNOWN_SENSORS as known_sensors
     source = os.path.abspath(os.path.expanduser(path))
     text = load_file(source, parse_args(model_args))
     model = parse_urdf(text, source)
@@ -200,7 +200,7 @@ def build_report(path, model_args="", controller_files=(), known=None, resolve_p
         if blk is not None and blk.unknown_tags:
             warnings.append(f"{blk.path}: unknown tags ignored: {', '.join(blk.unknown_tags)}")
 
-    from .physics import World  # PyBullet, only once the model is known to be good
+    from diffbot_sim.physics import World  # PyBullet, only once the model is known to be good
 
     world = World(1.0 / 240.0)
     try:

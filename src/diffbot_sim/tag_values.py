@@ -14,7 +14,7 @@ here. Vectors (``<pose>``, noise vectors) are read strictly too: a stream of sev
 """
 import re
 
-from .errors import ConfigError
+from diffbot_sim.errors import ConfigError
 
 # std::stod: decimal with optional exponent, or inf/infinity/nan (any case), after optional white space.
 _DOUBLE = re.compile(r"\s*([+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan))", re.IGNORECASE)
@@ -46,7 +46,7 @@ def tag_number(label, text, notes, integer=False, **limits):
     Raises:
         ConfigError: no leading number (naming ``label``), or a value out of ``limits``.
     """
-    from .config import _number
+    from diffbot_sim.config import _number
 
     if not isinstance(text, str):
         number = _number(label, text, **limits)

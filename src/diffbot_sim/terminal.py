@@ -12,8 +12,8 @@ import os
 import select
 import termios
 
-from . import streams
-from .errors import TerminalError
+from diffbot_sim import streams
+from diffbot_sim.errors import TerminalError
 
 #: What :func:`read_key` returns when standard input is closed (end of file, or the terminal hung up).
 EOF = ""

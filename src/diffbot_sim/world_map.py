@@ -41,8 +41,8 @@ import re
 import numpy as np
 import yaml
 
-from .errors import ConfigError, ModelError
-from .world import IDENTITY, Body, Shape, WorldDescription
+from diffbot_sim.errors import ConfigError, ModelError
+from diffbot_sim.world import IDENTITY, Body, Shape, WorldDescription
 
 #: The keys map_server requires (main.cpp exits when one is missing).
 REQUIRED_KEYS = ("image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh")

@@ -14,7 +14,7 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from .world_sdf import compose
+from diffbot_sim.world_sdf import compose
 
 #: Colour of shapes whose world gives none (rviz rgba, 0..1): light grey, visible on rviz's dark background.
 DEFAULT_COLOR = (0.7, 0.7, 0.72, 1.0)

@@ -32,10 +32,10 @@ import math
 import os
 import xml.etree.ElementTree as ET
 
-from .errors import ConfigError, ModelError
-from .tag_values import tag_number
-from .transforms import qmul as _qmul
-from .world import IDENTITY, Body, Shape, WorldDescription
+from diffbot_sim.errors import ConfigError, ModelError
+from diffbot_sim.tag_values import tag_number
+from diffbot_sim.transforms import qmul as _qmul
+from diffbot_sim.world import IDENTITY, Body, Shape, WorldDescription
 
 #: The SDF versions this reader knows; others are read as the nearest one (with a warning).
 VERSIONS = ((1, 4), (1, 5), (1, 6), (1, 7), (1, 8), (1, 9))

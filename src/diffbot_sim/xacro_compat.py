@@ -28,7 +28,7 @@ import os
 import re
 import sys
 
-from .errors import ModelError
+from diffbot_sim.errors import ModelError
 
 #: The xacro release line these patches are written against.
 SUPPORTED_SERIES = "1.13."

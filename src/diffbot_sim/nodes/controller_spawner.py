@@ -30,8 +30,8 @@ from controller_manager_msgs.srv import (ListControllers, ListControllersRequest
                                          UnloadControllerRequest)
 from std_msgs.msg import Bool
 
-from .. import gazebo_cli
-from ..gazebo_cli import CliError, UsageExit
+from diffbot_sim import gazebo_cli
+from diffbot_sim.gazebo_cli import CliError, UsageExit
 
 #: Errors a call to a controller_manager service can raise (gone, refused connection, shutdown).
 CALL_ERRORS = (rospy.ServiceException, rospy.ROSException)

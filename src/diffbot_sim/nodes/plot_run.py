@@ -20,7 +20,7 @@ import sys
 import threading
 import time
 
-from .. import plot_data, streams
+from diffbot_sim import plot_data, streams
 
 
 def parse_argv(argv):

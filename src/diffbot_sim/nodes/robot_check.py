@@ -28,9 +28,9 @@ import tempfile
 import threading
 import time
 
-from .. import drive_check, robot_report, streams
-from ..description import package_path
-from ..errors import DiffbotSimError, ModelError
+from diffbot_sim import drive_check, robot_report, streams
+from diffbot_sim.description import package_path
+from diffbot_sim.errors import DiffbotSimError, ModelError
 
 USAGE = ("usage: rosrun diffbot_sim robot_check <model.urdf|model.urdf.xacro> [controller.yaml ...] "
          "[-- xacro args name:=value ...]")
@@ -102,7 +102,7 @@ def _main(argv):
     yamls = [os.path.abspath(os.path.expanduser(y)) for y in yamls]
     try:
         files = [(path, _load_yaml(path)) for path in yamls]
-        from ..plugins.registry import KNOWN
+        from diffbot_sim.plugins.registry import KNOWN
         report = robot_report.build_report(model, model_args, [(p, tree) for p, (tree, _) in files], KNOWN,
                                            package_path)
     except DiffbotSimError as err:

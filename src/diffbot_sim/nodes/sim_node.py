@@ -27,15 +27,15 @@ from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
-from .. import config as cfgmod
-from .. import meshes, ros_msgs, streams
-from ..description import load_file, load_world, package_path, parse_args
-from ..errors import DiffbotSimError, ModelError
-from ..model import parse_urdf, tag_value
-from ..physics import World
-from ..plugins import read_plugins, registry
-from ..plugins.base import RobotContext, get_param, next_due, publisher
-from ..throttle import Throttle
+from diffbot_sim import config as cfgmod
+from diffbot_sim import meshes, ros_msgs, streams
+from diffbot_sim.description import load_file, load_world, package_path, parse_args
+from diffbot_sim.errors import DiffbotSimError, ModelError
+from diffbot_sim.model import parse_urdf, tag_value
+from diffbot_sim.physics import World
+from diffbot_sim.plugins import read_plugins, registry
+from diffbot_sim.plugins.base import RobotContext, get_param, next_due, publisher
+from diffbot_sim.throttle import Throttle
 
 _CONTROLLER_SUFFIX = {"VelocityJointInterface": "velocity", "EffortJointInterface": "effort",
                       "PositionJointInterface": "position"}
@@ -569,7 +569,7 @@ def _world_api(sim, cfg, params):
     """The /gazebo services and topics (None, with a warning, when gazebo_msgs is not built: the overlay
     left out)."""
     try:
-        from .gazebo_api import GazeboApi
+        from diffbot_sim.nodes.gazebo_api import GazeboApi
     except ImportError as err:
         rospy.logwarn(f"bullet_sim: no {cfg.gazebo_namespace} services ({err}; the gazebo_msgs overlay "
                       "package is not built)")

@@ -26,8 +26,8 @@ from gazebo_msgs.srv import (DeleteModel, DeleteModelRequest, SetModelConfigurat
 from geometry_msgs.msg import Pose
 from std_srvs.srv import Empty, EmptyRequest
 
-from .. import gazebo_cli
-from ..gazebo_cli import CliError, UsageExit
+from diffbot_sim import gazebo_cli
+from diffbot_sim.gazebo_cli import CliError, UsageExit
 
 NODE_NAME = "spawn_model"
 #: How often ``-wait`` checks for its model (s, wall time): upstream's 10 Hz.

@@ -32,11 +32,11 @@ import rospy
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
-from ..errors import ConfigError, TerminalError
-from .. import ros_msgs, streams
-from ..keymap import BANNER, STOP, Teleop, TeleopConfig, format_status
-from ..kinematics import yaw_from_quaternion
-from ..terminal import EOF, StatusLine, raw_terminal, read_key, require_tty
+from diffbot_sim.errors import ConfigError, TerminalError
+from diffbot_sim import ros_msgs, streams
+from diffbot_sim.keymap import BANNER, STOP, Teleop, TeleopConfig, format_status
+from diffbot_sim.kinematics import yaw_from_quaternion
+from diffbot_sim.terminal import EOF, StatusLine, raw_terminal, read_key, require_tty
 
 NODE_NAME = "teleop_key"
 #: Longest wait for a key; bounds how late a ROS shutdown request and the status line are noticed.

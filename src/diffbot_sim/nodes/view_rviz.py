@@ -23,8 +23,8 @@ import os
 import sys
 import time
 
-from .. import rviz_config, streams
-from ..errors import DiffbotSimError
+from diffbot_sim import rviz_config, streams
+from diffbot_sim.errors import DiffbotSimError
 
 TEMPLATE = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(
     os.path.realpath(__file__))))), "rviz", "diffbot.rviz")
@@ -64,7 +64,7 @@ def _wait_param(master, name, timeout):
 def robot_views(master, sim, timeout):
     """A :class:`rviz_config.RobotView` per robot of the simulator at ``sim``, from its effective
     parameters and the topics it publishes."""
-    from .world_markers import robot_namespaces
+    from diffbot_sim.nodes.world_markers import robot_namespaces
 
     entries = _param(master, sim + "/robots")
     names = robot_namespaces(entries)
@@ -90,8 +90,8 @@ def robot_views(master, sim, timeout):
 
 def world_bounds(sim):
     """The world's static geometry extent in the world frame, or None without a world."""
-    from ..world_markers import bounds_xy, marker_specs
-    from .world_markers import _read_world
+    from diffbot_sim.world_markers import bounds_xy, marker_specs
+    from diffbot_sim.nodes.world_markers import _read_world
 
     world = _read_world(sim)
     return bounds_xy(marker_specs(world)) if world is not None else None

@@ -30,9 +30,9 @@ Exit status 1, with one line, on a world file that cannot be read or a simulator
 import math
 import time
 
-from .. import streams
-from ..errors import DiffbotSimError
-from ..world_markers import CUBE, CYLINDER, MESH_RESOURCE, SPHERE, TRIANGLE_LIST, marker_specs
+from diffbot_sim import streams
+from diffbot_sim.errors import DiffbotSimError
+from diffbot_sim.world_markers import CUBE, CYLINDER, MESH_RESOURCE, SPHERE, TRIANGLE_LIST, marker_specs
 
 _KINDS = {CUBE: 1, SPHERE: 2, CYLINDER: 3, MESH_RESOURCE: 10, TRIANGLE_LIST: 11}  # Marker type constants
 
@@ -104,7 +104,7 @@ def _read_world(sim):
     """The simulator's world, read from its ``~world`` parameter through the loader it uses itself."""
     import rospy
 
-    from ..description import load_world
+    from diffbot_sim.description import load_world
 
     name = rospy.get_param(sim + "/world", "") or rospy.get_param(sim + "/world_name", "")
     if not name:

@@ -17,10 +17,10 @@ CPU TinyRenderer) or ``egl`` (OpenGL off screen; falls back to tiny with one war
 """
 from sensor_msgs.msg import CameraInfo, Image
 
-from .. import camera_sensor as cam
-from .. import ros_msgs
-from ..errors import PluginNotLoaded
-from .base import Plugin, join
+from diffbot_sim import camera_sensor as cam
+from diffbot_sim import ros_msgs
+from diffbot_sim.errors import PluginNotLoaded
+from diffbot_sim.plugins.base import Plugin, join
 
 def choose_renderer(ctx):
     """The renderer cameras use: ``~renderer`` (SimConfig), which the simulator set back to ``tiny`` (with
@@ -162,7 +162,7 @@ def create(ctx, sensor, plugin_element, params):
     cfg = cam.parse_sensor(sensor.element, sensor.path, sensor.name)
     tags = cam.read_plugin(plugin_element, sensor.path)
     if sensor.type == "depth":
-        from .depth import DepthCamera
+        from diffbot_sim.plugins.depth import DepthCamera
         tags.dialect = "ros2"
         return DepthCamera(ctx, sensor, cfg, tags)
     return Camera(ctx, sensor, cfg, tags)

@@ -16,9 +16,9 @@ import math
 import numpy as np
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 
-from .. import camera_sensor as cam
-from .. import ros_msgs
-from .camera import CameraBase
+from diffbot_sim import camera_sensor as cam
+from diffbot_sim import ros_msgs
+from diffbot_sim.plugins.camera import CameraBase
 
 
 class DepthCamera(CameraBase):

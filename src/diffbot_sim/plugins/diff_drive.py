@@ -14,12 +14,12 @@ import rospy
 from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 
-from .. import config as cfgmod
-from .. import ros_msgs
-from ..controller import DiffDriveController
-from ..kinematics import quaternion_from_yaw
-from ..odometry import EncoderOdometry
-from .base import Plugin, finite_twist, join, next_due
+from diffbot_sim import config as cfgmod
+from diffbot_sim import ros_msgs
+from diffbot_sim.controller import DiffDriveController
+from diffbot_sim.kinematics import quaternion_from_yaw
+from diffbot_sim.odometry import EncoderOdometry
+from diffbot_sim.plugins.base import Plugin, finite_twist, join, next_due
 
 
 class DiffDrive(Plugin):

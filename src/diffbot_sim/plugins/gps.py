@@ -22,12 +22,12 @@ import math
 from geometry_msgs.msg import Vector3Stamped
 from sensor_msgs.msg import NavSatFix
 
-from .. import noise, ros_msgs
-from ..config import _bool
-from ..errors import ModelError, PluginNotLoaded
-from ..tag_values import tag_number
-from .base import Plugin, join
-from .imu import read_tags
+from diffbot_sim import noise, ros_msgs
+from diffbot_sim.config import _bool
+from diffbot_sim.errors import ModelError, PluginNotLoaded
+from diffbot_sim.tag_values import tag_number
+from diffbot_sim.plugins.base import Plugin, join
+from diffbot_sim.plugins.imu import read_tags
 
 FILENAME = "libhector_gazebo_ros_gps.so"
 #: WGS84 ellipsoid.

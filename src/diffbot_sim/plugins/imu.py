@@ -36,13 +36,13 @@ import xml.etree.ElementTree as ET
 
 from sensor_msgs.msg import Imu
 
-from .. import noise, ros_msgs
-from ..config import _bool
-from ..errors import ConfigError, ModelError, PluginNotLoaded
-from ..model import tag_value
-from ..tag_values import tag_number
-from ..transforms import qconj, qmul
-from .base import Plugin, join
+from diffbot_sim import noise, ros_msgs
+from diffbot_sim.config import _bool
+from diffbot_sim.errors import ConfigError, ModelError, PluginNotLoaded
+from diffbot_sim.model import tag_value
+from diffbot_sim.tag_values import tag_number
+from diffbot_sim.transforms import qconj, qmul
+from diffbot_sim.plugins.base import Plugin, join
 
 SENSOR_FILENAME = "libgazebo_ros_imu_sensor.so"
 MODEL_FILENAME = "libgazebo_ros_imu.so"

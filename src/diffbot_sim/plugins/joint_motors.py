@@ -12,7 +12,7 @@ import threading
 
 from std_msgs.msg import Float64
 
-from .base import Plugin, join
+from diffbot_sim.plugins.base import Plugin, join
 
 #: Force/torque limit [N or N·m] of a motor whose joint has no URDF <limit effort>. Gazebo's is DBL_MAX: the
 #: motor reaches any commanded velocity at once. PyBullet's velocity motor is a constraint whose impulse is

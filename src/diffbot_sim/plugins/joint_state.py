@@ -5,9 +5,9 @@ Tags and defaults: :class:`diffbot_sim.config.JointStateConfig`.
 """
 from sensor_msgs.msg import JointState
 
-from .. import config as cfgmod
-from .. import ros_msgs
-from .base import Plugin, join
+from diffbot_sim import config as cfgmod
+from diffbot_sim import ros_msgs
+from diffbot_sim.plugins.base import Plugin, join
 
 
 class JointStatePublisher(Plugin):

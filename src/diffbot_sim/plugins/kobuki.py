@@ -23,14 +23,14 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import Empty
 
-from .. import ros_msgs
-from ..config import _bool, _string
-from ..errors import ModelError
-from ..kinematics import quaternion_from_yaw, wheel_speeds
-from ..model import tag_value
-from ..tag_values import tag_number
-from .base import Plugin, finite_twist, join
-from .joint_motors import UNLIMITED_EFFORT
+from diffbot_sim import ros_msgs
+from diffbot_sim.config import _bool, _string
+from diffbot_sim.errors import ModelError
+from diffbot_sim.kinematics import quaternion_from_yaw, wheel_speeds
+from diffbot_sim.model import tag_value
+from diffbot_sim.tag_values import tag_number
+from diffbot_sim.plugins.base import Plugin, finite_twist, join
+from diffbot_sim.plugins.joint_motors import UNLIMITED_EFFORT
 
 REQUIRED = ("left_wheel_joint_name", "right_wheel_joint_name", "wheel_separation", "wheel_diameter",
             "torque", "velocity_command_timeout")

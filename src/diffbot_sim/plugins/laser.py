@@ -22,12 +22,12 @@ casting is ``World.ray_batch``. As gazebo_ros does:
 """
 from sensor_msgs.msg import LaserScan, PointCloud, PointCloud2, Range
 
-from .. import ray_sensor, ros_msgs
-from ..config import _string
-from ..errors import ConfigError
-from ..model import tag_value
-from ..tag_values import tag_number
-from .base import Plugin, join
+from diffbot_sim import ray_sensor, ros_msgs
+from diffbot_sim.config import _string
+from diffbot_sim.errors import ConfigError
+from diffbot_sim.model import tag_value
+from diffbot_sim.tag_values import tag_number
+from diffbot_sim.plugins.base import Plugin, join
 
 ROS1_LASERS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so")
 ROS2_RAY = "libgazebo_ros_ray_sensor.so"

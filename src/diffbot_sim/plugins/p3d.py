@@ -11,11 +11,11 @@ here a lumped link works too.
 """
 from nav_msgs.msg import Odometry
 
-from .. import noise, ros_msgs
-from ..errors import ModelError, PluginNotLoaded
-from ..tag_values import tag_number
-from .base import Plugin, join
-from .imu import qconj, qmul, qnormalize, qrotate, quaternion_from_rpy, read_tags, vector
+from diffbot_sim import noise, ros_msgs
+from diffbot_sim.errors import ModelError, PluginNotLoaded
+from diffbot_sim.tag_values import tag_number
+from diffbot_sim.plugins.base import Plugin, join
+from diffbot_sim.plugins.imu import qconj, qmul, qnormalize, qrotate, quaternion_from_rpy, read_tags, vector
 
 FILENAME = "libgazebo_ros_p3d.so"
 WORLD_FRAMES = ("world", "/world", "map", "/map", "")

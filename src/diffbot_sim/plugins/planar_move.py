@@ -11,11 +11,11 @@ import threading
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
-from .. import ros_msgs
-from ..config import _bool, _string
-from ..model import tag_value
-from ..tag_values import tag_number
-from .base import Plugin, finite_twist, join
+from diffbot_sim import ros_msgs
+from diffbot_sim.config import _bool, _string
+from diffbot_sim.model import tag_value
+from diffbot_sim.tag_values import tag_number
+from diffbot_sim.plugins.base import Plugin, finite_twist, join
 
 DEFAULTS = {"commandTopic": "cmd_vel", "odometryTopic": "odom", "odometryFrame": "odom",
             "robotBaseFrame": "base_footprint", "odometryRate": 20.0, "publishOdometryTf": True,

@@ -13,11 +13,11 @@ warning; gazebo_ros says ``/world``); ``radiation`` (``ultrasound``, anything el
 """
 from sensor_msgs.msg import Range as RangeMsg
 
-from .. import ray_sensor, ros_msgs
-from ..config import _string
-from ..tag_values import tag_number
-from .base import join
-from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
+from diffbot_sim import ray_sensor, ros_msgs
+from diffbot_sim.config import _string
+from diffbot_sim.tag_values import tag_number
+from diffbot_sim.plugins.base import join
+from diffbot_sim.plugins.laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
 
 _READ = ("robotNamespace", "topicName", "frameName", "radiation", "fov", "gaussianNoise", "updateRate")
 

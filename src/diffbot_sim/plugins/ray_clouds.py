@@ -15,11 +15,11 @@ sensor_msgs/PointCloud2 with x, y, z, intensity, ring, time). Casting and range 
 """
 import numpy as np
 
-from .. import ros_msgs
-from ..config import _bool
-from ..tag_values import tag_number
-from .base import join
-from .laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
+from diffbot_sim import ros_msgs
+from diffbot_sim.config import _bool
+from diffbot_sim.tag_values import tag_number
+from diffbot_sim.plugins.base import join
+from diffbot_sim.plugins.laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
 from sensor_msgs.msg import PointCloud, PointCloud2
 
 BLOCK = "libgazebo_ros_block_laser.so"

@@ -32,14 +32,14 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Bool, Float64
 
-from .. import controllers, ddc, ros_msgs, switching
-from ..config import _number, _string
-from ..errors import ConfigError, ModelError
-from ..kinematics import quaternion_from_yaw
-from ..model import tag_value
-from ..tag_values import tag_number
-from .base import Plugin, get_param, join, next_due
-from .joint_motors import effort_limit
+from diffbot_sim import controllers, ddc, ros_msgs, switching
+from diffbot_sim.config import _number, _string
+from diffbot_sim.errors import ConfigError, ModelError
+from diffbot_sim.kinematics import quaternion_from_yaw
+from diffbot_sim.model import tag_value
+from diffbot_sim.tag_values import tag_number
+from diffbot_sim.plugins.base import Plugin, get_param, join, next_due
+from diffbot_sim.plugins.joint_motors import effort_limit
 
 #: Controller update period [s] when the plugin gives no ``controlPeriod``. Gazebo runs controllers at
 #: every physics step (1 kHz in its default world); 100 Hz keeps real-time CPU low, and with velocity motors

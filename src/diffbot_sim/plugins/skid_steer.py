@@ -4,9 +4,9 @@ What differs from the diff drive is only configuration (:func:`diffbot_sim.confi
 tags ``leftFrontJoint``... ``torque``, ``broadcastTF`` (default false); odometry is always the world pose
 with covariances ``covariance_x/y/yaw`` (1e-4, 1e-4, 0.01); no acceleration limit, no timeout.
 """
-from .. import config as cfgmod
-from ..model import tag_value
-from .diff_drive import DiffDrive
+from diffbot_sim import config as cfgmod
+from diffbot_sim.model import tag_value
+from diffbot_sim.plugins.diff_drive import DiffDrive
 
 #: Tags the ROS 1 plugin has (or had) that change nothing here.
 IGNORED = {"alwaysOn", "rosDebugLevel", "legacyMode", "publishWheelTF", "publishWheelJointState",

@@ -11,7 +11,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional
 
-from ..errors import ModelError
+from diffbot_sim.errors import ModelError
 
 DIFF_DRIVE = "libgazebo_ros_diff_drive.so"
 JOINT_STATE = "libgazebo_ros_joint_state_publisher.so"
