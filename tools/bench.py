@@ -322,8 +322,8 @@ def bench_bare(seconds):
     """The same model (xacro'd, loaded the way bullet_sim loads it) stepped by PyBullet alone."""
     import pybullet
     sys.path.insert(0, os.path.join(ROOT, "src"))
-    from diffbot_sim.description import load_file
-    from diffbot_sim.model import parse_urdf
+    from diffbot_sim.description.model_files import load_file
+    from diffbot_sim.description.urdf_model import parse_urdf
     from diffbot_sim.physics import World
     text = load_file(MODEL)
     model = parse_urdf(text, MODEL)
@@ -352,8 +352,8 @@ def bench_bare_paced(seconds):
     import threading
     import pybullet
     sys.path.insert(0, os.path.join(ROOT, "src"))
-    from diffbot_sim.description import load_file
-    from diffbot_sim.model import parse_urdf
+    from diffbot_sim.description.model_files import load_file
+    from diffbot_sim.description.urdf_model import parse_urdf
     from diffbot_sim.physics import World
     text = load_file(MODEL)
     world = World(STEP)
@@ -595,7 +595,7 @@ def bench_worlds(runs, seconds):
     """Load times of a mesh world and of 4000 x 4000 maps; RTF in the example world against none."""
     import shutil
     sys.path.insert(0, os.path.join(ROOT, "src"))
-    from diffbot_sim import world_map
+    from diffbot_sim.world import map_image as world_map
     out = {}
     home = os.path.join(RESULTS, "ros_home_worlds")
     cache = os.path.join(home, "diffbot_sim", "mesh_cache")

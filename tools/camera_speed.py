@@ -43,10 +43,10 @@ def bare(frames):
     """Images per second of pybullet.getCameraImage alone, the node's view of the same scene."""
     import pybullet
 
-    from diffbot_sim import camera_sensor as cam
-    from diffbot_sim.model import parse_urdf
+    from diffbot_sim.sensors import camera as cam
+    from diffbot_sim.description.urdf_model import parse_urdf
     from diffbot_sim.physics import World
-    from diffbot_sim.world_sdf import read_world
+    from diffbot_sim.world.sdf_reader import read_world
 
     world = World(1.0 / 240.0)
     world.load_world(read_world(WORLD, model_paths=[]), tempfile.mkdtemp())

@@ -16,7 +16,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "src"))
 
-from diffbot_sim import meshes  # noqa: E402
+from diffbot_sim.description import meshes  # noqa: E402
 
 RECORD = np.dtype([("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attribute", "<u2")])
 
@@ -88,7 +88,7 @@ def main():
         t_hit, _ = best(cached, args.repeat)
         print(f"prepare_meshes cached: {t_hit * 1000:.2f} ms")
 
-        from diffbot_sim.model import parse_urdf
+        from diffbot_sim.description.urdf_model import parse_urdf
         from diffbot_sim.physics import World
 
         def load(urdf_text):

@@ -25,7 +25,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "src"))
 
-from diffbot_sim import xscreen  # noqa: E402
+from diffbot_sim.view import xscreen  # noqa: E402
 
 DOCS = os.path.join(ROOT, "docs")
 ROBOT = os.path.join(ROOT, "tests", "data", "robots", "view_robot.urdf")
@@ -180,7 +180,7 @@ class Recorder:
 
 
 def main():
-    from diffbot_sim import plot_data
+    from diffbot_sim.view import plot_data
     from diffbot_sim.nodes import plot_run
 
     os.makedirs(DOCS, exist_ok=True)

@@ -15,7 +15,7 @@ DEBS=(
   python3-rospkg python3-tf2-ros ros-robot-state-publisher
   python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-std-msgs python3-std-srvs
   python3-tf2-msgs python3-rosgraph-msgs
-  # map_server map images other than PGM (PNG, BMP...): diffbot_sim.world_map reads them with Pillow
+  # map_server map images other than PGM (PNG, BMP...): diffbot_sim.world.map_image reads them with Pillow
   python3-pil
   # tests
   python3-pytest liburdfdom-tools iproute2 procps python3-rosnode
@@ -68,16 +68,16 @@ if [ ! -x "$VENV/bin/python" ] || [ "$(cat "$STAMP" 2>/dev/null)" != "$want_sha"
   echo "$want_sha" > "$STAMP"
 fi
 
-# Launch files run `xacro file.xacro`: it must be xacro 1.13.3 plus diffbot_sim.xacro_compat (noetic's
+# Launch files run `xacro file.xacro`: it must be xacro 1.13.3 plus diffbot_sim.description.xacro_compat (noetic's
 # features), not pip's bare entry point. pip rewrites .venv/bin/xacro whenever it (re)installs xacro, so
 # compare the content on every run instead of trusting the requirements stamp. src/ is a fallback import
 # path for when the workspace is not sourced.
 XACRO_BIN="$VENV/bin/xacro"
 XACRO_LAUNCHER="#!$VENV/bin/python
 import sys; sys.path.append('$ROOT/src')
-from diffbot_sim.xacro_compat import main; sys.exit(main())"
+from diffbot_sim.description.xacro_compat import main; sys.exit(main())"
 if [ "$(cat "$XACRO_BIN" 2>/dev/null)" != "$XACRO_LAUNCHER" ]; then
-  log "installing the xacro launcher (xacro 1.13.3 + diffbot_sim.xacro_compat) as $XACRO_BIN"
+  log "installing the xacro launcher (xacro 1.13.3 + diffbot_sim.description.xacro_compat) as $XACRO_BIN"
   printf '%s\n' "$XACRO_LAUNCHER" > "$XACRO_BIN.tmp"
   chmod 755 "$XACRO_BIN.tmp"
   mv -f "$XACRO_BIN.tmp" "$XACRO_BIN"

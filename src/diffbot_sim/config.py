@@ -10,7 +10,7 @@ from dataclasses import asdict, dataclass, field, fields
 from typing import List, Optional
 
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.tag_values import tag_number
+from diffbot_sim.values import tag_number
 
 #: Wheel speed cap [rad/s] when neither ``~max_wheel_velocity`` nor the URDF ``<limit velocity>`` gives one:
 #: keeps a 1e308 command from reaching the physics as an absurd motor target.
@@ -383,7 +383,7 @@ def as_params(cfg):
 def _drive_value(key, value, label, notes, from_tag=False):
     """``value`` of DriveConfig field ``key``, validated; a value Gazebo tolerates with a warning appends
     that warning to ``notes``. A number ``from_tag`` (a plugin tag's text) is read as Gazebo reads it: its
-    leading number (:func:`diffbot_sim.tag_values.tag_number`)."""
+    leading number (:func:`diffbot_sim.values.tag_number`)."""
     def number(**limits):
         return tag_number(label, value, notes, **limits) if from_tag else _number(label, value, **limits)
 

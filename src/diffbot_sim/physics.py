@@ -9,7 +9,7 @@ import math
 import os
 import tempfile
 
-from diffbot_sim import lumping
+from diffbot_sim.description import lumping
 from diffbot_sim.errors import ModelError
 
 #: Gazebo's friction coefficient for a surface that gives none (SDF <surface><friction><ode><mu> default).
@@ -126,7 +126,7 @@ class World:
         """Load a robot; returns a Robot. ``model`` is the parsed RobotModel of the same text. The root link
         frame is placed at ``position`` turned by ``yaw``, or by the quaternion ``orientation`` when given.
 
-        Fixed links are lumped as Gazebo lumps them (:mod:`diffbot_sim.lumping`), not by PyBullet's
+        Fixed links are lumped as Gazebo lumps them (:mod:`diffbot_sim.description.lumping`), not by PyBullet's
         URDF_MERGE_FIXED_LINKS, which would give inertia-less links 1 kg and a merged body one friction.
         """
         prepared = lumping.lump(urdf_text, model.root, model.surface)
@@ -150,7 +150,7 @@ class World:
         return robot
 
     def load_world(self, world, mesh_cache):
-        """Build a :class:`diffbot_sim.world.WorldDescription`: one PyBullet body per world body.
+        """Build a :class:`diffbot_sim.world.bodies.WorldDescription`: one PyBullet body per world body.
 
         Static bodies get mass 0; their meshes collide as the triangles they are (a hollow ring stays
         hollow), dynamic ones as convex hulls (what Bullet can simulate). Mesh files are converted and cached
@@ -200,7 +200,7 @@ class World:
 
     def _compound(self, shapes, static, mesh_cache):
         """One collision shape index for a body's shapes (a compound when there are several)."""
-        from diffbot_sim import meshes  # pure; here only to convert world meshes
+        from diffbot_sim.description import meshes  # pure; here only to convert world meshes
 
         c = self.client
         concave = pybullet.GEOM_FORCE_CONCAVE_TRIMESH if static else 0
@@ -356,7 +356,7 @@ class World:
         TinyRenderer; "egl": the EGL plugin (``use_egl`` must have succeeded; else TinyRenderer draws)."""
         import numpy as np
 
-        from diffbot_sim import camera_sensor
+        from diffbot_sim.sensors import camera as camera_sensor
         c = self.client
         eye, target, up = camera_sensor.look_at(view_pose)
         view = pybullet.computeViewMatrix(eye, target, up, physicsClientId=c)

@@ -1,4 +1,5 @@
-"""Rotations as plain numbers (pure; numpy only): URDF/SDF roll-pitch-yaw and (x, y, z, w) quaternions.
+"""Rotations and poses as plain numbers (pure; numpy only): URDF/SDF roll-pitch-yaw, (x, y, z, w)
+quaternions, and poses composed and inverted.
 
 One place for the conventions every reader shares: fixed-axis roll, pitch, yaw (R = Rz(yaw) Ry(pitch)
 Rx(roll), as URDF and SDF define them) and Hamilton quaternions in ROS's (x, y, z, w) order.
@@ -30,3 +31,48 @@ def qmul(a, b):
 def qconj(q):
     """The conjugate (the inverse of a unit quaternion)."""
     return (-q[0], -q[1], -q[2], q[3])
+
+
+# ------------------------------------------------------------------------------------------------ poses
+# A pose is ((x, y, z), (qx, qy, qz, qw)), plain tuples.
+
+def qnormalize(q):
+    """``q`` scaled to unit length (the identity for a zero quaternion)."""
+    n = math.sqrt(sum(c * c for c in q))
+    return tuple(c / n for c in q) if n > 0 else (0.0, 0.0, 0.0, 1.0)
+
+
+def rotate(q, v):
+    """Vector ``v`` turned by the unit quaternion ``q`` (x, y, z, w)."""
+    x, y, z, w = q
+    # v + 2 w (u x v) + 2 u x (u x v), with u the vector part: no matrix needed.
+    cx, cy, cz = y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0]
+    return (v[0] + 2 * (w * cx + y * cz - z * cy),
+            v[1] + 2 * (w * cy + z * cx - x * cz),
+            v[2] + 2 * (w * cz + x * cy - y * cx))
+
+
+def compose(a, b):
+    """``a * b``: pose ``b`` (given in frame ``a``) expressed in ``a``'s parent frame."""
+    (pa, qa), (pb, qb) = a, b
+    p = rotate(qa, pb)
+    return ((pa[0] + p[0], pa[1] + p[1], pa[2] + p[2]), qnormalize(qmul(qa, qb)))
+
+
+def inverse(a):
+    """The pose that undoes ``a``: ``compose(a, inverse(a)) == IDENTITY``."""
+    p, (x, y, z, w) = a
+    qi = (-x, -y, -z, w)
+    r = rotate(qi, p)
+    return ((-r[0], -r[1], -r[2]), qi)
+
+
+def rpy_quaternion(roll, pitch, yaw):
+    """SDF's fixed-axis roll, pitch, yaw (R = Rz(yaw) Ry(pitch) Rx(roll)) -> quaternion (x, y, z, w)."""
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (sr * cp * cy - cr * sp * sy,
+            cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy,
+            cr * cp * cy + sr * sp * sy)

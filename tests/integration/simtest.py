@@ -17,7 +17,7 @@ from tf2_msgs.msg import TFMessage
 
 SIM = "/bullet_sim"
 #: m / rad: a driving body stays this close to its rest height, and tilts less than this (drive_check's bounds).
-from diffbot_sim.drive_check import HEIGHT_TOLERANCE, MAX_TILT  # noqa: E402
+from diffbot_sim.check.drive_check import HEIGHT_TOLERANCE, MAX_TILT  # noqa: E402
 
 
 def yaw_of(q):
@@ -65,7 +65,7 @@ class Truth:
     stores). Drive checks judge the body by it: odometry is the robot's claim, this is where it is."""
 
     def __init__(self, topic=SIM + "/ground_truth"):
-        from diffbot_sim import drive_check
+        from diffbot_sim.check import drive_check
 
         self._sample = drive_check.body_sample
         self.lock = threading.Lock()
@@ -90,7 +90,7 @@ class Truth:
     def ride(self, start, end, height=0.0, what="driving"):
         """The body between two sim times, judged by drive_check.ride (at ``height``, upright); raises
         AssertionError naming what went wrong."""
-        from diffbot_sim import drive_check
+        from diffbot_sim.check import drive_check
 
         body = self.between(start, end)
         result = drive_check.ride(body, height, what)
@@ -101,7 +101,7 @@ class Truth:
 
 def assert_upright(pose, height, what):
     """A geometry_msgs/Pose of a driven robot (from /gazebo/get_model_state) rests at ``height`` and upright."""
-    from diffbot_sim import drive_check
+    from diffbot_sim.check import drive_check
 
     sample = drive_check.body_sample(0.0, (pose.position.x, pose.position.y, pose.position.z),
                                      (pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w))

@@ -18,7 +18,7 @@ import rostest
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 
-from diffbot_sim import camera_sensor as cam
+from diffbot_sim.sensors import camera as cam
 
 SIM = "/bullet_sim"
 CAMERA_IN_FOOTPRINT = (0.1, 0.0, 0.083)  # base_footprint -> base_link 0.033 up, base_link -> camera (0.1, 0, 0.05)

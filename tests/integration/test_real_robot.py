@@ -18,7 +18,7 @@ world pose (gazebo_ros_skid_steer_drive), so in the turn it is held to the groun
 ~imu_topic (optional): the base IMU a drive plugin publishes reads +9.81 m/s^2 on z and no yaw rate at rest
 (REP 145). The launch file starts bullet_sim paused; this node unpauses it once it listens.
 Callbacks only record; waits poll with deadlines; times are sim time. The motions and the body are judged by
-diffbot_sim.drive_check, shared with `robot_check`.
+diffbot_sim.check.drive_check, shared with `robot_check`.
 """
 import math
 import sys
@@ -33,8 +33,8 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu
 from std_srvs.srv import Empty
 
-from diffbot_sim import drive_check
-from diffbot_sim.drive_check import SECONDS, SPEED, TURN, wrap
+from diffbot_sim.check import drive_check
+from diffbot_sim.check.drive_check import SECONDS, SPEED, TURN, wrap
 
 SIM = "/bullet_sim"
 

@@ -30,7 +30,7 @@ from gazebo_msgs.srv import DeleteModel, GetModelState, GetWorldProperties, SetM
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import viewtest  # noqa: E402
 
-from diffbot_sim import xscreen  # noqa: E402
+from diffbot_sim.view import xscreen  # noqa: E402
 
 ROOM = os.path.join(viewtest.ROOT, "worlds", "room.world")
 ROBOT = "diffbot"  # the seed robot's URDF name: its model name

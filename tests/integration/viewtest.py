@@ -21,7 +21,7 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
 
-from diffbot_sim import xscreen
+from diffbot_sim.view import xscreen
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
 ROBOT = os.path.join(ROOT, "tests", "data", "robots", "view_robot.urdf")

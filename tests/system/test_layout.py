@@ -77,7 +77,7 @@ def test_model_passes_check_urdf(tmp_path):
     if shutil.which("check_urdf") is None:
         pytest.fail("check_urdf (Debian liburdfdom-tools) is not installed: make setup installs it")
     sys.path.insert(0, os.path.join(ROOT, "src"))
-    from diffbot_sim.description import load_file
+    from diffbot_sim.description.model_files import load_file
 
     urdf = tmp_path / "diffbot.urdf"
     urdf.write_text(load_file(os.path.join(ROOT, "urdf", "diffbot.urdf.xacro")))

@@ -25,7 +25,7 @@ def pytest_configure(config):
 @pytest.fixture(scope="session")
 def seed_urdf():
     """The seed robot (urdf/diffbot.urdf.xacro) run through xacro once per session: URDF text."""
-    from diffbot_sim.description import load_file
+    from diffbot_sim.description.model_files import load_file
 
     return load_file(SEED_XACRO)
 
@@ -33,7 +33,7 @@ def seed_urdf():
 @pytest.fixture
 def seed_model(seed_urdf):
     """A fresh RobotModel of the seed robot (cheap to parse; fresh so no test can leak changes)."""
-    from diffbot_sim.model import parse_urdf
+    from diffbot_sim.description.urdf_model import parse_urdf
 
     return parse_urdf(seed_urdf, SEED_XACRO)
 
@@ -117,7 +117,7 @@ def make_transmission():
 @pytest.fixture(scope="session")
 def parse():
     """``parse(text, source='test.urdf')`` -> RobotModel."""
-    from diffbot_sim.model import parse_urdf
+    from diffbot_sim.description.urdf_model import parse_urdf
 
     def _parse(text, source="test.urdf"):
         return parse_urdf(text, source)

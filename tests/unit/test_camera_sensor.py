@@ -7,7 +7,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from diffbot_sim import camera_sensor as cam
+from diffbot_sim.sensors import camera as cam
 from diffbot_sim.errors import ConfigError
 
 PATH = "/robot/gazebo[@reference='camera_link']/sensor[@name='c']"

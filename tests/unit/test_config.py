@@ -339,8 +339,8 @@ def test_sim_config_rejects(key, value):
 # --- wheel limits resolved from params, URDF and fallback (config.max_wheel_velocity / wheel_efforts) ---
 
 def _seed_drive():
-    from diffbot_sim.description import load_file
-    from diffbot_sim.model import parse_urdf
+    from diffbot_sim.description.model_files import load_file
+    from diffbot_sim.description.urdf_model import parse_urdf
     from diffbot_sim.plugins import read_plugins
     import os
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))

@@ -1,12 +1,11 @@
 """description.py: xacro in-process with $(arg) mappings, errors naming the file, parse_args, mesh URIs."""
 import os
-import xml.etree.ElementTree as ET
 
 import pytest
 
-from diffbot_sim.description import load_file, parse_args, resolve_meshes, resolve_uri
+from diffbot_sim.description.model_files import load_file, parse_args
 from diffbot_sim.errors import ModelError
-from diffbot_sim.model import parse_urdf
+from diffbot_sim.description.urdf_model import parse_urdf
 
 
 @pytest.fixture
@@ -99,49 +98,3 @@ def test_parse_args_bad_token(text):
         parse_args(text)
     assert "~model_args" in str(info.value)
     assert "is not name:=value" in str(info.value)
-
-
-MESH_URDF = """<robot name="m"><link name="a">
-  <visual><geometry><mesh filename="package://fake_meshes/meshes/body.stl" scale="1 1 1"/></geometry></visual>
-  <collision><geometry><mesh filename="file:///opt/meshes/body.dae"/></geometry></collision>
-  <collision><geometry><mesh filename="relative/keep.obj"/></geometry></collision>
-</link></robot>"""
-
-
-@pytest.fixture
-def fake_package(tmp_path, monkeypatch):
-    pkg = tmp_path / "ws" / "fake_meshes"
-    pkg.mkdir(parents=True)
-    (pkg / "package.xml").write_text(
-        '<?xml version="1.0"?><package format="2"><name>fake_meshes</name><version>0.0.1</version>'
-        '<description>test</description><maintainer email="t@example.com">t</maintainer>'
-        "<license>BSD</license></package>")
-    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path / "ws"))
-    return pkg
-
-
-def test_resolve_meshes_rewrites_package_and_file_uris(fake_package):
-    out = resolve_meshes(MESH_URDF, "m.urdf")
-    filenames = [m.get("filename") for m in ET.fromstring(out).iter("mesh")]
-    assert filenames == [os.path.join(str(fake_package), "meshes/body.stl"), "/opt/meshes/body.dae",
-                         "relative/keep.obj"]
-    assert 'scale="1 1 1"' in out
-
-
-def test_resolve_uri(fake_package):
-    assert resolve_uri("package://fake_meshes/a/b.stl", "s") == os.path.join(str(fake_package), "a/b.stl")
-    assert resolve_uri("file:///x/y.stl", "s") == "/x/y.stl"
-    assert resolve_uri("/abs/z.stl", "s") == "/abs/z.stl"
-
-
-def test_unknown_package_raises(fake_package):
-    text = MESH_URDF.replace("package://fake_meshes", "package://no_such_pkg_xyz")
-    with pytest.raises(ModelError) as info:
-        resolve_meshes(text, "robot.urdf")
-    assert str(info.value).startswith("robot.urdf: ")
-    assert "no_such_pkg_xyz" in str(info.value)
-
-
-def test_text_without_uris_unchanged():
-    text = '<robot name="r"><link name="a"><visual><geometry><mesh filename="m.stl"/></geometry></visual></link></robot>'
-    assert resolve_meshes(text, "s") is text

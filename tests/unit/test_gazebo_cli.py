@@ -9,8 +9,8 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from diffbot_sim import gazebo_cli
-from diffbot_sim.gazebo_cli import CliError, UsageExit
+from diffbot_sim.gazebo import cli as gazebo_cli
+from diffbot_sim.gazebo.cli import CliError, UsageExit
 
 
 def spawn(*args, ns="/"):
@@ -18,7 +18,7 @@ def spawn(*args, ns="/"):
 
 
 def test_no_rospy_at_import():
-    code = "import sys; import diffbot_sim.gazebo_cli; sys.exit('rospy' in sys.modules)"
+    code = "import sys; import diffbot_sim.gazebo.cli; sys.exit('rospy' in sys.modules)"
     subprocess.run([sys.executable, "-c", code], check=True, cwd=gazebo_cli.__file__.rsplit("/", 2)[0])
 
 

@@ -6,10 +6,11 @@ import xml.etree.ElementTree as ET
 import pytest
 
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.model import parse_urdf
+from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.physics import World
+from diffbot_sim import transforms
 from diffbot_sim.plugins import gps, imu, p3d
-from diffbot_sim.plugins.tags import SensorElement
+from diffbot_sim.description.plugin_tags import SensorElement
 
 PATH = "/robot/gazebo[@reference='imu_link']/sensor[@name='imu']"
 
@@ -105,24 +106,26 @@ def test_hector_imu_tags_defaults_and_heading_tags_ignored():
 # ---------------------------------------------------------------------------------------- maths
 
 def test_quaternions():
-    q = imu.quaternion_from_rpy(0, 0, math.pi / 2)
+    from diffbot_sim.transforms import qconj, qmul, qnormalize, rotate, rpy_quaternion
+
+    q = rpy_quaternion(0, 0, math.pi / 2)
     assert q == pytest.approx((0, 0, math.sqrt(0.5), math.sqrt(0.5)))
-    assert imu.qrotate(q, (1, 0, 0)) == pytest.approx((0, 1, 0))
-    assert imu.qmul(q, imu.qconj(q)) == pytest.approx((0, 0, 0, 1))
-    q = imu.quaternion_from_rpy(0.1, -0.2, 0.3)  # fixed-axis: Rz(yaw) Ry(pitch) Rx(roll)
-    composed = imu.qmul(imu.quaternion_from_rpy(0, 0, 0.3),
-                        imu.qmul(imu.quaternion_from_rpy(0, -0.2, 0), imu.quaternion_from_rpy(0.1, 0, 0)))
+    assert rotate(q, (1, 0, 0)) == pytest.approx((0, 1, 0))
+    assert qmul(q, qconj(q)) == pytest.approx((0, 0, 0, 1))
+    q = rpy_quaternion(0.1, -0.2, 0.3)  # fixed-axis: Rz(yaw) Ry(pitch) Rx(roll)
+    composed = qmul(rpy_quaternion(0, 0, 0.3), qmul(rpy_quaternion(0, -0.2, 0), rpy_quaternion(0.1, 0, 0)))
     assert q == pytest.approx(composed)
+    assert qnormalize((0, 0, 0, 0)) == (0.0, 0.0, 0.0, 1.0)
 
 
 def test_reading_offsets_reference_and_noise():
     st = imu.ImuSettings(rpy_offset=(0, 0, math.pi / 2))
     r = imu.Reading(st)
     o, w, a = r((0, 0, 0, 1), (0, 0, 0.5), (0, 0, 9.81), 0.01)
-    assert o == pytest.approx(imu.quaternion_from_rpy(0, 0, math.pi / 2)) and w == (0, 0, 0.5)
+    assert o == pytest.approx(transforms.rpy_quaternion(0, 0, math.pi / 2)) and w == (0, 0, 0.5)
     st = imu.ImuSettings(initial_reference=True)
     r = imu.Reading(st)
-    start = imu.quaternion_from_rpy(0, 0, 1.0)
+    start = transforms.rpy_quaternion(0, 0, 1.0)
     assert r(start, (0, 0, 0), (0, 0, 0), 0.01)[0] == pytest.approx((0, 0, 0, 1))
     st = imu.ImuSettings(gaussian_noise=0.1, orientation_noise=True, generator=__import__("random").Random(1))
     r = imu.Reading(st)
@@ -132,7 +135,7 @@ def test_reading_offsets_reference_and_noise():
 
 def test_hector_orientation_error_is_yaw_then_tilt():
     error = imu.hector_orientation_error(0.2, (0.0, 0.0, 0.0), 9.81)
-    assert error == pytest.approx(imu.quaternion_from_rpy(0, 0, 0.2))
+    assert error == pytest.approx(transforms.rpy_quaternion(0, 0, 0.2))
     error = imu.hector_orientation_error(0.0, (0.0981, 0.0, 0.0), 9.81)  # x drift -> pitch error
     assert error[1] < 0 and error[0] == 0 and error[2] == 0
 
@@ -154,7 +157,7 @@ def test_p3d_tags_defaults_and_required():
 
 
 def test_p3d_relative_to_a_link():
-    q90 = imu.quaternion_from_rpy(0, 0, math.pi / 2)
+    q90 = transforms.rpy_quaternion(0, 0, math.pi / 2)
     body = (((1.0, 1.0, 0.0), q90), (0.0, 1.0, 0.0), (0.0, 0.0, 0.5))
     ref = (((1.0, 0.0, 0.0), q90), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
     (p, q), v, w = p3d.relative(body, ref)
@@ -252,7 +255,7 @@ def test_lumped_imu_at_rest_reads_plus_g_and_no_rate(box):
         assert w == pytest.approx((0.0, 0.0, 0.0), abs=1e-3)
     pose = readings[-1][0]
     assert pose[0] == pytest.approx((0.1, 0.0, robot.base_pose()[0][2] + 0.05), abs=1e-6)
-    assert pose[1] == pytest.approx(imu.quaternion_from_rpy(0, 0, math.pi / 2), abs=1e-4)
+    assert pose[1] == pytest.approx(transforms.rpy_quaternion(0, 0, math.pi / 2), abs=1e-4)
 
 
 def test_imu_in_a_known_spin_reads_the_yaw_rate_and_centripetal_acceleration(box):

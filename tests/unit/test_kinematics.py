@@ -3,7 +3,7 @@ import math
 
 import pytest
 
-from diffbot_sim.kinematics import body_velocity, wheel_speeds
+from diffbot_sim.control.kinematics import body_velocity, wheel_speeds
 
 
 @pytest.mark.parametrize("linear, angular, separation", [
@@ -54,7 +54,7 @@ def test_arc_radius():
 def test_planar_quaternion_round_trip():
     import math
 
-    from diffbot_sim.kinematics import quaternion_from_yaw, yaw_from_quaternion
+    from diffbot_sim.control.kinematics import quaternion_from_yaw, yaw_from_quaternion
 
     for yaw in (-3.0, -1.0, 0.0, 0.5, 3.0):
         assert yaw_from_quaternion(*quaternion_from_yaw(yaw)) == pytest.approx(yaw)

@@ -1,7 +1,7 @@
 """limits.py: clamp, scale_to_limit (keeps the wheel ratio), ramp, SpeedLimiter (diff_drive_controller's)."""
 import pytest
 
-from diffbot_sim.limits import SpeedLimiter, clamp, ramp, scale_to_limit
+from diffbot_sim.control.limits import SpeedLimiter, clamp, ramp, scale_to_limit
 
 
 @pytest.mark.parametrize("value, limit, expected", [

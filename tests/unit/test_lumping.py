@@ -9,9 +9,13 @@ import numpy as np
 import pybullet
 import pytest
 
-from diffbot_sim import lumping, meshes, physics
-from diffbot_sim.description import load_file
-from diffbot_sim.model import parse_urdf
+from diffbot_sim import physics
+
+from diffbot_sim.description import lumping
+
+from diffbot_sim.description import meshes
+from diffbot_sim.description.model_files import load_file
+from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.physics import World
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))

@@ -11,7 +11,7 @@ import numpy as np
 import pybullet
 import pytest
 
-from diffbot_sim import meshes
+from diffbot_sim.description import meshes
 from diffbot_sim.errors import ModelError
 
 # A box 1000 x 1000 x 500 (mm), centred on the origin: 8 corners, 12 outward-wound triangles.
@@ -487,7 +487,7 @@ MARGIN = 0.01
 
 @pytest.mark.parametrize("writer", [write_binary_stl, write_ascii_stl])
 def test_pybullet_box_mesh_has_metre_size(model, world, writer):
-    from diffbot_sim.model import parse_urdf
+    from diffbot_sim.description.urdf_model import parse_urdf
 
     writer(model / "model" / "meshes" / "box.stl", box_triangles())
     write_dae(model / "model" / "meshes" / "wheel.dae")
@@ -504,7 +504,7 @@ def test_pybullet_box_mesh_has_metre_size(model, world, writer):
 
 
 def test_pybullet_y_up_dae_honoured_is_turned(model, world):
-    from diffbot_sim.model import parse_urdf
+    from diffbot_sim.description.urdf_model import parse_urdf
 
     write_dae(model / "model" / "meshes" / "wheel.dae")
     text, _ = prepare(mesh_robot("meshes/box.stl", "meshes/wheel.dae", wheel_scale="2 2 2"), model,

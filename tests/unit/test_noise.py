@@ -1,11 +1,11 @@
-"""diffbot_sim.noise: SDF <noise> and plugin noise, seeded (no ROS)."""
+"""diffbot_sim.sensors.noise: SDF <noise> and plugin noise, seeded (no ROS)."""
 import math
 import statistics
 import xml.etree.ElementTree as ET
 
 import pytest
 
-from diffbot_sim import noise
+from diffbot_sim.sensors import noise
 from diffbot_sim.errors import ModelError
 
 

@@ -4,7 +4,7 @@ import math
 import pytest
 
 from diffbot_sim.errors import ConfigError
-from diffbot_sim.odometry import EncoderOdometry, integrate_exact
+from diffbot_sim.control.odometry import EncoderOdometry, integrate_exact
 
 R, S = 0.032, 0.2  # the seed's wheel radius and separation
 

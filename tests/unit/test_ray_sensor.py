@@ -1,4 +1,4 @@
-"""Ray sensors: SDF reading and defaults, Gazebo 7+'s angles and range semantics (diffbot_sim.ray_sensor),
+"""Ray sensors: SDF reading and defaults, Gazebo 7+'s angles and range semantics (diffbot_sim.sensors.ray),
 and the casting (physics.World.ray_batch) against a hand-built room, checked beam by beam by hand."""
 import math
 import os
@@ -7,7 +7,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from diffbot_sim import ray_sensor as rs
+from diffbot_sim.sensors import ray as rs
 from diffbot_sim.errors import ConfigError
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -205,9 +205,9 @@ def test_scan_points_drop_non_finite():
 def room():
     """A World with static walls and a pillar (laser_retro on two of them) and the laser robot at the
     origin: yields (world, robot, model)."""
-    from diffbot_sim.model import parse_urdf
+    from diffbot_sim.description.urdf_model import parse_urdf
     from diffbot_sim.physics import World
-    from diffbot_sim.world import Body, Shape, WorldDescription
+    from diffbot_sim.world.bodies import Body, Shape, WorldDescription
 
     def box(name, x, y, sx, sy, retro=None):
         surface = {"laser_retro": retro} if retro else {}
@@ -228,7 +228,7 @@ def room():
 
 
 def lds_config(model):
-    from diffbot_sim.plugins.tags import read_plugins
+    from diffbot_sim.description.plugin_tags import read_plugins
 
     found = read_plugins(model)
     el = next(s for s in found.sensors if s.name == "lds")
@@ -334,7 +334,7 @@ def test_laserscan_bytes_match_genpy():
     import genpy
     from sensor_msgs.msg import LaserScan
 
-    from diffbot_sim import ros_msgs
+    from diffbot_sim.ros import messages as ros_msgs
 
     builder = ros_msgs.LaserScanBuilder("robot1/laser", 0.0, 6.28319, 6.28319 / 359, 0.12, 10.0)
     ranges = np.array([1.5, math.inf, -math.inf, 0.25])
@@ -359,7 +359,7 @@ def test_range_and_pointcloud2_builders():
     import genpy
     from sensor_msgs.msg import PointCloud2, Range
 
-    from diffbot_sim import ros_msgs
+    from diffbot_sim.ros import messages as ros_msgs
 
     r = ros_msgs.RangeBuilder("sonar", True, 0.1, 0.02, 4.0).build(genpy.Time(1, 0), 2.5)
     assert (r.radiation_type, r.field_of_view, r.min_range, r.max_range, r.range) == (Range.ULTRASOUND, 0.1, 0.02,
@@ -407,8 +407,8 @@ class _Ctx:
 
 
 def _plugin_robot(sensor_xml):
-    from diffbot_sim.model import parse_urdf
-    from diffbot_sim.plugins.tags import read_plugins
+    from diffbot_sim.description.urdf_model import parse_urdf
+    from diffbot_sim.description.plugin_tags import read_plugins
 
     text = ('<robot name="bot"><link name="base_link"/><link name="laser_link"/>'
             '<joint name="j" type="fixed"><parent link="base_link"/><child link="laser_link"/></joint>'
@@ -530,7 +530,7 @@ def test_ros2_outputs_publish_from_the_room(room, monkeypatch, output):
     import genpy
 
     from diffbot_sim.plugins import base, laser
-    from diffbot_sim.plugins.tags import read_plugins
+    from diffbot_sim.description.plugin_tags import read_plugins
 
     world, robot, model = room
     monkeypatch.setattr(base, "publisher", _Listened)

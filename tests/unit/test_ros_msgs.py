@@ -7,7 +7,7 @@ from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 from geometry_msgs.msg import TransformStamped
 
-from diffbot_sim import ros_msgs
+from diffbot_sim.ros import messages as ros_msgs
 
 
 def _bytes(serialize, msg):

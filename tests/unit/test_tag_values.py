@@ -5,7 +5,7 @@ import math
 import pytest
 
 from diffbot_sim.errors import ConfigError
-from diffbot_sim.tag_values import leading_number, tag_number
+from diffbot_sim.values import leading_number, tag_number
 
 
 @pytest.mark.parametrize("text, value, rest", [

@@ -10,7 +10,7 @@ import time
 import pytest
 
 from diffbot_sim.errors import DiffbotSimError, TerminalError
-from diffbot_sim.terminal import EOF, NOT_A_TTY, StatusLine, key_mode, raw_terminal, read_key, require_tty
+from diffbot_sim.teleop.terminal import EOF, NOT_A_TTY, StatusLine, key_mode, raw_terminal, read_key, require_tty
 
 
 @pytest.fixture

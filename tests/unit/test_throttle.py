@@ -1,5 +1,5 @@
 """throttle.py: per-key warning rate limiter."""
-from diffbot_sim.throttle import Throttle
+from diffbot_sim.simulator.throttle import Throttle
 
 
 def test_first_call_passes_then_held_for_period():

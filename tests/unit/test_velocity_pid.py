@@ -2,7 +2,7 @@
 stable, and the gains published robots carry (tuned for Gazebo's 1 ms step) are not, at ours."""
 import pytest
 
-from diffbot_sim.model import parse_urdf
+from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.physics import World
 from diffbot_sim.plugins.ros_control import STABLE_LOOP_GAIN, Pid, loop_gain
 

@@ -10,8 +10,8 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from diffbot_sim import world_api as api
-from diffbot_sim.world_sdf import compose, rpy_quaternion
+from diffbot_sim.gazebo import world_api as api
+from diffbot_sim.transforms import compose, rpy_quaternion
 
 S = math.sqrt(0.5)
 YAW90 = (0.0, 0.0, S, S)

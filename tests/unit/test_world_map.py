@@ -1,4 +1,4 @@
-"""diffbot_sim.world_map: map_server YAML + image -> one static trimesh of walls (pure; no master)."""
+"""diffbot_sim.world.map_image: map_server YAML + image -> one static trimesh of walls (pure; no master)."""
 import math
 import os
 import time
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.world_map import (MAX_BOXES_PER_BODY, REQUIRED_KEYS, MapImage, merge_rectangles, occupancy, read_map, read_pgm,
+from diffbot_sim.world.map_image import (MAX_BOXES_PER_BODY, REQUIRED_KEYS, MapImage, merge_rectangles, occupancy, read_map, read_pgm,
                                    synthetic_map, walls_mesh)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))

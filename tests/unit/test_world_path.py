@@ -5,8 +5,8 @@ import os
 import pytest
 
 from diffbot_sim.errors import ModelError
-from diffbot_sim.description import resolve_world_path
-from diffbot_sim.world_sdf import read_world
+from diffbot_sim.world.loading import resolve_world_path
+from diffbot_sim.world.sdf_reader import read_world
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 

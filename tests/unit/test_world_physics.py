@@ -7,9 +7,9 @@ import numpy as np
 import pybullet
 import pytest
 
-from diffbot_sim import meshes
+from diffbot_sim.description import meshes
 from diffbot_sim.physics import World
-from diffbot_sim.world import Body, Shape, WorldDescription
+from diffbot_sim.world.bodies import Body, Shape, WorldDescription
 
 DT = 1.0 / 240.0
 

@@ -9,10 +9,10 @@ import os
 
 import pytest
 
-from diffbot_sim import meshes
+from diffbot_sim.description import meshes
 from diffbot_sim.errors import ModelError
-from diffbot_sim.world_sdf import (compose, env_model_paths, inverse, read_world, ros_package_model_paths,
-                                   rpy_quaternion)
+from diffbot_sim.transforms import compose, inverse, rpy_quaternion
+from diffbot_sim.world.sdf_reader import env_model_paths, read_world, ros_package_model_paths
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ROOM = os.path.join(ROOT, "worlds", "room.world")

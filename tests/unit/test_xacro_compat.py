@@ -1,7 +1,7 @@
 """xacro_compat.py: noetic (xacro 1.14) descriptions through the PyPI xacro 1.13.3 plus our patches.
 
 Every feature runs twice: in-process through ``description.load_file`` and as the ``xacro`` command on
-PATH (what launch files run), which tools/setup.sh points at ``diffbot_sim.xacro_compat:main``. Marked
+PATH (what launch files run), which tools/setup.sh points at ``diffbot_sim.description.xacro_compat:main``. Marked
 "1.13.3 lacks" are the features that fail without the compatibility layer; the others are checked so a
 xacro upgrade or a patch cannot lose them.
 """
@@ -15,8 +15,8 @@ from types import SimpleNamespace
 
 import pytest
 
-from diffbot_sim import xacro_compat
-from diffbot_sim.description import load_file
+from diffbot_sim.description import xacro_compat
+from diffbot_sim.description.model_files import load_file
 from diffbot_sim.errors import ModelError
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "xacro")
@@ -475,7 +475,7 @@ def test_xacro_command_on_path_is_the_compat_launcher():
     assert command, "no xacro on PATH"
     with open(command, encoding="utf-8") as handle:
         lines = handle.read().splitlines()
-    assert len(lines) == 3 and "diffbot_sim.xacro_compat import main" in lines[2], \
+    assert len(lines) == 3 and "diffbot_sim.description.xacro_compat import main" in lines[2], \
         f"{command} is not the launcher tools/setup.sh installs; run `make setup`"
     assert lines[0] == "#!" + os.path.join(os.path.dirname(command), "python")
 

@@ -3,7 +3,7 @@
 
 Launch files written for Gazebo run ``<node pkg="controller_manager" type="spawner" args="joint_state_controller
 diff_drive_controller"/>``; overlay/controller_manager's scripts run these nodes. Arguments are parsed by
-:mod:`diffbot_sim.gazebo_cli`; here is only the ROS side.
+:mod:`diffbot_sim.gazebo.cli`; here is only the ROS side.
 
 Services called (controller_manager_msgs; ``<cm>`` is ``[--namespace/]controller_manager``, relative to the
 node's namespace unless absolute): ``<cm>/load_controller`` (LoadController: name),
@@ -30,8 +30,8 @@ from controller_manager_msgs.srv import (ListControllers, ListControllersRequest
                                          UnloadControllerRequest)
 from std_msgs.msg import Bool
 
-from diffbot_sim import gazebo_cli
-from diffbot_sim.gazebo_cli import CliError, UsageExit
+from diffbot_sim.gazebo import cli as gazebo_cli
+from diffbot_sim.gazebo.cli import CliError, UsageExit
 
 #: Errors a call to a controller_manager service can raise (gone, refused connection, shutdown).
 CALL_ERRORS = (rospy.ServiceException, rospy.ROSException)

@@ -2,7 +2,7 @@
 
 Three panels: the odometry trajectory against ground truth (and the last laser scan, in the odometry
 frame), commanded against measured linear speed, and the same for the turn rate, over sim time. What is
-read and how frames are joined is :mod:`diffbot_sim.plot_data`; this module reads the bag (rosbag's Python
+read and how frames are joined is :mod:`diffbot_sim.view.plot_data`; this module reads the bag (rosbag's Python
 API) or listens live, and draws with matplotlib's Agg backend (no display needed).
 
 Record a run with ground truth, for example:
@@ -20,7 +20,9 @@ import sys
 import threading
 import time
 
-from diffbot_sim import plot_data, streams
+from diffbot_sim import streams
+
+from diffbot_sim.view import plot_data
 
 
 def parse_argv(argv):

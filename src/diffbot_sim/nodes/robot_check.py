@@ -2,10 +2,10 @@
 
 Someone moving a robot from Gazebo wants one screen that says whether it drives here, and if not, why. The
 static part (mass, drive and where its geometry came from, plugins, warnings) comes from
-:mod:`diffbot_sim.robot_report`, in this process. Then the robot is driven for real: a private master
+:mod:`diffbot_sim.check.robot_report`, in this process. Then the robot is driven for real: a private master
 (``roscore -p <free port>``), the controller YAMLs loaded onto it, ``bullet_sim`` headless at 3x real time
 with ground truth, and this process as a node publishing the commands and judging the motions with
-:mod:`diffbot_sim.drive_check` (the rules the fixture-robot rostests use).
+:mod:`diffbot_sim.check.drive_check` (the rules the fixture-robot rostests use).
 
 Paced at 3x real time, not fast mode (measured, 4 runs each on tests/data/robots/ros_control_4wd.urdf with
 its YAML, whose DiffDriveController has ``cmd_vel_timeout: 0.25``): in fast mode the tool's 20 Hz commands
@@ -28,8 +28,12 @@ import tempfile
 import threading
 import time
 
-from diffbot_sim import drive_check, robot_report, streams
-from diffbot_sim.description import package_path
+from diffbot_sim import streams
+
+from diffbot_sim.check import drive_check
+
+from diffbot_sim.check import robot_report
+from diffbot_sim.description.model_files import package_path
 from diffbot_sim.errors import DiffbotSimError, ModelError
 
 USAGE = ("usage: rosrun diffbot_sim robot_check <model.urdf|model.urdf.xacro> [controller.yaml ...] "
@@ -326,7 +330,7 @@ def _message(line):
 
 class _Latest:
     """The newest message of a topic as an ``(x, y, yaw)`` pose, and every message since ``start_span`` as
-    a :class:`diffbot_sim.drive_check.BodySample` (callbacks only store)."""
+    a :class:`diffbot_sim.check.drive_check.BodySample` (callbacks only store)."""
 
     def __init__(self):
         self.lock = threading.Lock()

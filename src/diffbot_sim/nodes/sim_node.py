@@ -28,14 +28,17 @@ from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
 from diffbot_sim import config as cfgmod
-from diffbot_sim import meshes, ros_msgs, streams
-from diffbot_sim.description import load_file, load_world, package_path, parse_args
+from diffbot_sim import streams
+from diffbot_sim.description import meshes
+from diffbot_sim.ros import messages as ros_msgs
+from diffbot_sim.description.model_files import load_file, package_path, parse_args
+from diffbot_sim.world.loading import load_world
 from diffbot_sim.errors import DiffbotSimError, ModelError
-from diffbot_sim.model import parse_urdf, tag_value
+from diffbot_sim.description.urdf_model import parse_urdf, tag_value
 from diffbot_sim.physics import World
 from diffbot_sim.plugins import read_plugins, registry
 from diffbot_sim.plugins.base import RobotContext, get_param, next_due, publisher
-from diffbot_sim.throttle import Throttle
+from diffbot_sim.simulator.throttle import Throttle
 
 _CONTROLLER_SUFFIX = {"VelocityJointInterface": "velocity", "EffortJointInterface": "effort",
                       "PositionJointInterface": "position"}
@@ -569,7 +572,7 @@ def _world_api(sim, cfg, params):
     """The /gazebo services and topics (None, with a warning, when gazebo_msgs is not built: the overlay
     left out)."""
     try:
-        from diffbot_sim.nodes.gazebo_api import GazeboApi
+        from diffbot_sim.simulator.gazebo_services import GazeboApi
     except ImportError as err:
         rospy.logwarn(f"bullet_sim: no {cfg.gazebo_namespace} services ({err}; the gazebo_msgs overlay "
                       "package is not built)")

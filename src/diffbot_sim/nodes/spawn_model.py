@@ -2,7 +2,7 @@
 
 Launch files written for Gazebo run ``<node pkg="gazebo_ros" type="spawn_model" args="-urdf -param
 robot_description -model r1 -x 1 ..."/>``; overlay/gazebo_ros's ``spawn_model`` script runs this node. The
-arguments mean what they mean in ROS 1 noetic (parsed by :mod:`diffbot_sim.gazebo_cli`); the node only
+arguments mean what they mean in ROS 1 noetic (parsed by :mod:`diffbot_sim.gazebo.cli`); the node only
 does the ROS side, in upstream's order:
 
 1. ``-wait MODEL``: wait until MODEL is in ``<gazebo_ns>/model_states`` (checked at 10 Hz);
@@ -26,8 +26,8 @@ from gazebo_msgs.srv import (DeleteModel, DeleteModelRequest, SetModelConfigurat
 from geometry_msgs.msg import Pose
 from std_srvs.srv import Empty, EmptyRequest
 
-from diffbot_sim import gazebo_cli
-from diffbot_sim.gazebo_cli import CliError, UsageExit
+from diffbot_sim.gazebo import cli as gazebo_cli
+from diffbot_sim.gazebo.cli import CliError, UsageExit
 
 NODE_NAME = "spawn_model"
 #: How often ``-wait`` checks for its model (s, wall time): upstream's 10 Hz.

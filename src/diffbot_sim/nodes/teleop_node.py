@@ -1,6 +1,6 @@
 """Keyboard teleop node ``teleop_key``: keys typed in its terminal become Twists on ``cmd_vel``.
 
-A thin shell around :mod:`diffbot_sim.keymap` (what a key means) and :mod:`diffbot_sim.terminal` (how keys
+A thin shell around :mod:`diffbot_sim.teleop.keymap` (what a key means) and :mod:`diffbot_sim.teleop.terminal` (how keys
 are read). One thread does everything: wait up to 50 ms for a key, let the keymap answer, publish, redraw
 the status line. Whatever ends the node (the Ctrl-C key, SIGINT, SIGTERM, SIGHUP, standard input closing,
 an exception, a ROS shutdown request) publishes exactly one all-zero Twist while the node is still up, then
@@ -13,7 +13,7 @@ Publications:
 Subscriptions:
     odom (nav_msgs/Odometry): optional; while it arrives, the status line shows the pose x, y, yaw.
 
-Parameters (private; defaults in :class:`diffbot_sim.keymap.TeleopConfig`):
+Parameters (private; defaults in :class:`diffbot_sim.teleop.keymap.TeleopConfig`):
     ~speed (float, m/s), ~turn (float, rad/s): speeds at start.
     ~repeat_rate (float, Hz): re-publish the last command at this rate; 0: only on key presses.
     ~key_timeout (float, s): stop when no key arrived for this long while moving; 0: never.
@@ -33,10 +33,11 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
 from diffbot_sim.errors import ConfigError, TerminalError
-from diffbot_sim import ros_msgs, streams
-from diffbot_sim.keymap import BANNER, STOP, Teleop, TeleopConfig, format_status
-from diffbot_sim.kinematics import yaw_from_quaternion
-from diffbot_sim.terminal import EOF, StatusLine, raw_terminal, read_key, require_tty
+from diffbot_sim import streams
+from diffbot_sim.ros import messages as ros_msgs
+from diffbot_sim.teleop.keymap import BANNER, STOP, Teleop, TeleopConfig, format_status
+from diffbot_sim.control.kinematics import yaw_from_quaternion
+from diffbot_sim.teleop.terminal import EOF, StatusLine, raw_terminal, read_key, require_tty
 
 NODE_NAME = "teleop_key"
 #: Longest wait for a key; bounds how late a ROS shutdown request and the status line are noticed.

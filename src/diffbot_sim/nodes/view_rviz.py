@@ -1,7 +1,7 @@
 """``rosrun diffbot_sim view_rviz [--view top|3d] [--template FILE] [--config FILE]``: rviz for this run.
 
 ``view.launch`` starts this instead of ``rviz`` directly because no fixed rviz file fits every robot (see
-:mod:`diffbot_sim.rviz_config`). It waits until the simulator has loaded its robots (their effective
+:mod:`diffbot_sim.view.rviz_config`). It waits until the simulator has loaded its robots (their effective
 parameters appear on the parameter server), asks the master which LaserScan and Image topics the simulator
 publishes, reads the world file for the view's extent, writes the config to
 ``$ROS_HOME/diffbot_sim/view.rviz`` and then *becomes* rviz (``exec``): the process roslaunch watches, the
@@ -23,7 +23,9 @@ import os
 import sys
 import time
 
-from diffbot_sim import rviz_config, streams
+from diffbot_sim import streams
+
+from diffbot_sim.view import rviz_config
 from diffbot_sim.errors import DiffbotSimError
 
 TEMPLATE = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(
@@ -90,7 +92,7 @@ def robot_views(master, sim, timeout):
 
 def world_bounds(sim):
     """The world's static geometry extent in the world frame, or None without a world."""
-    from diffbot_sim.world_markers import bounds_xy, marker_specs
+    from diffbot_sim.world.markers import bounds_xy, marker_specs
     from diffbot_sim.nodes.world_markers import _read_world
 
     world = _read_world(sim)

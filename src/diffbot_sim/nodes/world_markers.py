@@ -32,7 +32,7 @@ import time
 
 from diffbot_sim import streams
 from diffbot_sim.errors import DiffbotSimError
-from diffbot_sim.world_markers import CUBE, CYLINDER, MESH_RESOURCE, SPHERE, TRIANGLE_LIST, marker_specs
+from diffbot_sim.world.markers import CUBE, CYLINDER, MESH_RESOURCE, SPHERE, TRIANGLE_LIST, marker_specs
 
 _KINDS = {CUBE: 1, SPHERE: 2, CYLINDER: 3, MESH_RESOURCE: 10, TRIANGLE_LIST: 11}  # Marker type constants
 
@@ -45,7 +45,7 @@ def make_marker_array(world, frame_id="world", warnings=None):
     every time, and rviz then uses the latest transform instead of waiting for one at a given stamp.
 
     Args:
-        world: a :class:`diffbot_sim.world.WorldDescription`.
+        world: a :class:`diffbot_sim.world.bodies.WorldDescription`.
         frame_id: the world's frame in TF.
         warnings: a list that gets one line per thing left out.
 
@@ -104,7 +104,7 @@ def _read_world(sim):
     """The simulator's world, read from its ``~world`` parameter through the loader it uses itself."""
     import rospy
 
-    from diffbot_sim.description import load_world
+    from diffbot_sim.world.loading import load_world
 
     name = rospy.get_param(sim + "/world", "") or rospy.get_param(sim + "/world_name", "")
     if not name:

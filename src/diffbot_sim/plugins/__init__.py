@@ -5,6 +5,6 @@ world update: each module here owns its tags (both dialects where Gazebo had two
 endpoints and its per-step work. The simulator's loop asks every plugin of every robot what is due and
 knows none by name. ``tags`` (pure) reads the plugin elements of a model.
 """
-from diffbot_sim.plugins.tags import DIFF_DRIVE, JOINT_STATE, PluginBlock, Plugins, read_plugins
+from diffbot_sim.description.plugin_tags import DIFF_DRIVE, JOINT_STATE, PluginBlock, Plugins, read_plugins
 
 __all__ = ["DIFF_DRIVE", "JOINT_STATE", "PluginBlock", "Plugins", "read_plugins"]

@@ -17,8 +17,8 @@ CPU TinyRenderer) or ``egl`` (OpenGL off screen; falls back to tiny with one war
 """
 from sensor_msgs.msg import CameraInfo, Image
 
-from diffbot_sim import camera_sensor as cam
-from diffbot_sim import ros_msgs
+from diffbot_sim.sensors import camera as cam
+from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.errors import PluginNotLoaded
 from diffbot_sim.plugins.base import Plugin, join
 

@@ -16,8 +16,8 @@ import math
 import numpy as np
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 
-from diffbot_sim import camera_sensor as cam
-from diffbot_sim import ros_msgs
+from diffbot_sim.sensors import camera as cam
+from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.plugins.camera import CameraBase
 
 

@@ -7,7 +7,7 @@ hector's default ``/world`` loses its slash, which tf2 rejects), ``topicName`` (
 ``referenceHeading`` [deg] (0), ``referenceAltitude`` [m] (0), ``status`` (0: STATUS_FIX), ``service``
 (1: GPS), ``updateRate`` (0: every step) or ``updatePeriod``, ``robotNamespace``; position error
 ``offset``, ``drift``, ``driftFrequency``, ``gaussianNoise``, ``scaleError`` (3 values or one) and the same
-with the ``velocity`` prefix (:class:`diffbot_sim.noise.HectorModel`; the velocity drift is integrated into
+with the ``velocity`` prefix (:class:`diffbot_sim.sensors.noise.HectorModel`; the velocity drift is integrated into
 the position drift, as hector does). ``useWorldSphericalCoordinates`` is ignored (warned): worlds here carry
 no ``<spherical_coordinates>``.
 
@@ -22,12 +22,14 @@ import math
 from geometry_msgs.msg import Vector3Stamped
 from sensor_msgs.msg import NavSatFix
 
-from diffbot_sim import noise, ros_msgs
+from diffbot_sim.sensors import noise
+
+from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.config import _bool
 from diffbot_sim.errors import ModelError, PluginNotLoaded
-from diffbot_sim.tag_values import tag_number
+from diffbot_sim.values import tag_number
 from diffbot_sim.plugins.base import Plugin, join
-from diffbot_sim.plugins.imu import read_tags
+from diffbot_sim.description.plugin_tags import read_tags
 
 FILENAME = "libhector_gazebo_ros_gps.so"
 #: WGS84 ellipsoid.

@@ -2,7 +2,7 @@
 Gazebo's p3d plugin gives them; for judging odometry. Enabled by ``~publish_ground_truth``."""
 from nav_msgs.msg import Odometry
 
-from diffbot_sim import ros_msgs
+from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.plugins.base import Plugin
 
 

@@ -28,7 +28,7 @@ Tags and defaults (sensors.md §3, §5):
   ``headingDrift``/``headingGaussianNoise`` (Husky, Jackal) are not hector tags: ignored with a warning.
 
 SDF noise (``<imu><angular_velocity|linear_acceleration><x|y|z><noise>``, or SDF 1.4's
-``<imu><noise><rate|accel>``) is seeded from ``~seed`` and the sensor's name (:mod:`diffbot_sim.noise`).
+``<imu><noise><rate|accel>``) is seeded from ``~seed`` and the sensor's name (:mod:`diffbot_sim.sensors.noise`).
 """
 import copy
 import math
@@ -36,12 +36,15 @@ import xml.etree.ElementTree as ET
 
 from sensor_msgs.msg import Imu
 
-from diffbot_sim import noise, ros_msgs
+from diffbot_sim.sensors import noise
+
+from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.config import _bool
-from diffbot_sim.errors import ConfigError, ModelError, PluginNotLoaded
-from diffbot_sim.model import tag_value
-from diffbot_sim.tag_values import tag_number
-from diffbot_sim.transforms import qconj, qmul
+from diffbot_sim.errors import ModelError, PluginNotLoaded
+from diffbot_sim.description.plugin_tags import read_tags, vector
+from diffbot_sim.description.urdf_model import tag_value
+from diffbot_sim.values import tag_number
+from diffbot_sim.transforms import qconj, qmul, qnormalize, rpy_quaternion
 from diffbot_sim.plugins.base import Plugin, join
 
 SENSOR_FILENAME = "libgazebo_ros_imu_sensor.so"
@@ -53,49 +56,13 @@ _COMMON = ("robotNamespace", "alwaysOn", "always_on", "updateRate", "update_rate
 
 # --------------------------------------------------------------------------------------- pure helpers
 
-def qrotate(q, v):
-    """``v`` rotated by unit quaternion ``q`` (frame -> world when q is the frame's orientation)."""
-    x, y, z, _ = qmul(qmul(q, (v[0], v[1], v[2], 0.0)), qconj(q))
-    return (x, y, z)
-
-
-def qnormalize(q):
-    n = math.sqrt(sum(c * c for c in q))
-    return tuple(c / n for c in q) if n > 0 else (0.0, 0.0, 0.0, 1.0)
-
-
-def quaternion_from_rpy(roll, pitch, yaw):
-    """(x, y, z, w) of URDF/SDF fixed-axis roll, pitch, yaw (Rz(yaw) Ry(pitch) Rx(roll))."""
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy,
-            cr * cp * cy + sr * sp * sy)
-
-
-def vector(text, where, tag, count=3):
-    """``count`` finite numbers from a tag's text."""
-    try:
-        values = tuple(float(v) for v in str(text).split())
-    except ValueError:
-        values = ()
-    if len(values) != count or not all(math.isfinite(v) for v in values):
-        raise ConfigError(f"<{tag}> of {where}", text, f"{count} finite numbers")
-    return values
-
-
-def read_tags(element):
-    """{tag: text} of a plugin element's direct children (both ``<a>v</a>`` and ``<a value="v"/>``)."""
-    return {child.tag: tag_value(child) for child in element} if element is not None else {}
-
-
 def sensor_pose(element, where):
     """The SDF sensor's ``<pose>`` (x y z roll pitch yaw) in its link: ((x, y, z), quaternion) or None."""
     pose = element.find("pose") if element is not None else None
     if pose is None or not (pose.text or "").strip():
         return None
     values = vector(pose.text, where, "pose", 6)
-    return values[:3], quaternion_from_rpy(*values[3:])
+    return values[:3], rpy_quaternion(*values[3:])
 
 
 def update_rate(element, where, notes=None):
@@ -329,7 +296,7 @@ class Reading:
     def __init__(self, settings, gravity=9.81):
         self.s = settings
         self.gravity = abs(gravity)
-        self.offset = quaternion_from_rpy(*settings.rpy_offset)
+        self.offset = rpy_quaternion(*settings.rpy_offset)
         self.reference = None
 
     def __call__(self, orientation, rate, accel, dt):

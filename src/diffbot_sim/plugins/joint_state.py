@@ -6,7 +6,7 @@ Tags and defaults: :class:`diffbot_sim.config.JointStateConfig`.
 from sensor_msgs.msg import JointState
 
 from diffbot_sim import config as cfgmod
-from diffbot_sim import ros_msgs
+from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.plugins.base import Plugin, join
 
 

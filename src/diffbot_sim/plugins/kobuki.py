@@ -23,12 +23,12 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import Empty
 
-from diffbot_sim import ros_msgs
+from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.config import _bool, _string
 from diffbot_sim.errors import ModelError
-from diffbot_sim.kinematics import quaternion_from_yaw, wheel_speeds
-from diffbot_sim.model import tag_value
-from diffbot_sim.tag_values import tag_number
+from diffbot_sim.control.kinematics import quaternion_from_yaw, wheel_speeds
+from diffbot_sim.description.urdf_model import tag_value
+from diffbot_sim.values import tag_number
 from diffbot_sim.plugins.base import Plugin, finite_twist, join
 from diffbot_sim.plugins.joint_motors import UNLIMITED_EFFORT
 

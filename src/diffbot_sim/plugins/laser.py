@@ -3,7 +3,7 @@
 PointCloud2, PointCloud or Range, by ``<output_type>``). Also the shared ray-sensor machinery
 (:class:`RaySensorPlugin`) that :mod:`diffbot_sim.plugins.range` uses.
 
-What the scan contains (angles, +inf misses, noise, intensities) is :mod:`diffbot_sim.ray_sensor`; the
+What the scan contains (angles, +inf misses, noise, intensities) is :mod:`diffbot_sim.sensors.ray`; the
 casting is ``World.ray_batch``. As gazebo_ros does:
 
 * ROS 1 tags: ``robotNamespace`` (absent: the node's namespace; present but empty: the model name),
@@ -22,11 +22,13 @@ casting is ``World.ray_batch``. As gazebo_ros does:
 """
 from sensor_msgs.msg import LaserScan, PointCloud, PointCloud2, Range
 
-from diffbot_sim import ray_sensor, ros_msgs
+from diffbot_sim.sensors import ray as ray_sensor
+
+from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.config import _string
 from diffbot_sim.errors import ConfigError
-from diffbot_sim.model import tag_value
-from diffbot_sim.tag_values import tag_number
+from diffbot_sim.description.urdf_model import tag_value
+from diffbot_sim.values import tag_number
 from diffbot_sim.plugins.base import Plugin, join
 
 ROS1_LASERS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so")

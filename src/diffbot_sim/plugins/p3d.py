@@ -11,11 +11,14 @@ here a lumped link works too.
 """
 from nav_msgs.msg import Odometry
 
-from diffbot_sim import noise, ros_msgs
+from diffbot_sim.sensors import noise
+
+from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.errors import ModelError, PluginNotLoaded
-from diffbot_sim.tag_values import tag_number
+from diffbot_sim.values import tag_number
 from diffbot_sim.plugins.base import Plugin, join
-from diffbot_sim.plugins.imu import qconj, qmul, qnormalize, qrotate, quaternion_from_rpy, read_tags, vector
+from diffbot_sim.description.plugin_tags import read_tags, vector
+from diffbot_sim.transforms import qconj, qmul, qnormalize, rotate, rpy_quaternion
 
 FILENAME = "libgazebo_ros_p3d.so"
 WORLD_FRAMES = ("world", "/world", "map", "/map", "")
@@ -47,8 +50,8 @@ def relative(body, reference):
         return (p, q), v, w
     (rp, rq), rv, rw = reference
     inv = qconj(rq)
-    return ((qrotate(inv, [p[i] - rp[i] for i in range(3)]), qnormalize(qmul(inv, q))),
-            qrotate(inv, [v[i] - rv[i] for i in range(3)]), qrotate(inv, [w[i] - rw[i] for i in range(3)]))
+    return ((rotate(inv, [p[i] - rp[i] for i in range(3)]), qnormalize(qmul(inv, q))),
+            rotate(inv, [v[i] - rv[i] for i in range(3)]), rotate(inv, [w[i] - rw[i] for i in range(3)]))
 
 
 class P3D(Plugin):
@@ -65,7 +68,7 @@ class P3D(Plugin):
             except KeyError:
                 raise PluginNotLoaded(f"p3d: '{link}' is not a link of the model; the plugin is not loaded, as in "
                                       "Gazebo", ctx.model.source, path) from None
-        self.offset_rot = quaternion_from_rpy(*values["rpy"])
+        self.offset_rot = rpy_quaternion(*values["rpy"])
         ns = ctx.plugin_namespace(values["namespace"])
         self.pub = ctx.publisher(join(ns, values["topic"]), Odometry)
         frame = ctx.clean_frame(values["frame"], path) or "world"

@@ -11,10 +11,10 @@ import threading
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
-from diffbot_sim import ros_msgs
+from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.config import _bool, _string
-from diffbot_sim.model import tag_value
-from diffbot_sim.tag_values import tag_number
+from diffbot_sim.description.urdf_model import tag_value
+from diffbot_sim.values import tag_number
 from diffbot_sim.plugins.base import Plugin, finite_twist, join
 
 DEFAULTS = {"commandTopic": "cmd_vel", "odometryTopic": "odom", "odometryFrame": "odom",

@@ -13,9 +13,11 @@ warning; gazebo_ros says ``/world``); ``radiation`` (``ultrasound``, anything el
 """
 from sensor_msgs.msg import Range as RangeMsg
 
-from diffbot_sim import ray_sensor, ros_msgs
+from diffbot_sim.sensors import ray as ray_sensor
+
+from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.config import _string
-from diffbot_sim.tag_values import tag_number
+from diffbot_sim.values import tag_number
 from diffbot_sim.plugins.base import join
 from diffbot_sim.plugins.laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
 

@@ -1,7 +1,7 @@
 """Ray sensors that publish point clouds: ``libgazebo_ros_block_laser.so`` (ROS 1, sensor_msgs/PointCloud)
 and ``libgazebo_ros_velodyne_laser.so`` / ``libgazebo_ros_velodyne_gpu_laser.so`` (velodyne_simulator,
 sensor_msgs/PointCloud2 with x, y, z, intensity, ring, time). Casting and range semantics are the laser's
-(:class:`diffbot_sim.plugins.laser.RaySensorPlugin`, :mod:`diffbot_sim.ray_sensor`).
+(:class:`diffbot_sim.plugins.laser.RaySensorPlugin`, :mod:`diffbot_sim.sensors.ray`).
 
 * Block laser (gazebo_ros_block_laser, sensors.md §1.2): tags ``robotNamespace``, ``topicName`` (``/world``),
   ``frameName``, ``gaussianNoise`` (0, on x, y, z of every finite point); ``hokuyoMinIntensity`` and
@@ -15,9 +15,9 @@ sensor_msgs/PointCloud2 with x, y, z, intensity, ring, time). Casting and range 
 """
 import numpy as np
 
-from diffbot_sim import ros_msgs
+from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.config import _bool
-from diffbot_sim.tag_values import tag_number
+from diffbot_sim.values import tag_number
 from diffbot_sim.plugins.base import join
 from diffbot_sim.plugins.laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
 from sensor_msgs.msg import PointCloud, PointCloud2

@@ -11,7 +11,7 @@ from diffbot_sim.plugins.joint_motors import JointMotors
 from diffbot_sim.plugins.laser import create_laser, create_ray_sensor
 from diffbot_sim.plugins.range import create as create_range
 from diffbot_sim.errors import PluginNotLoaded
-from diffbot_sim.plugins.tags import DIFF_DRIVE, JOINT_STATE, plugin_filename
+from diffbot_sim.description.plugin_tags import DIFF_DRIVE, JOINT_STATE, plugin_filename
 
 #: Model plugins by filename (``libNAME.so``).
 MODEL_PLUGINS = {
@@ -25,7 +25,7 @@ MODEL_PLUGINS = {
     "libhector_gazebo_ros_gps.so": gps.create,
 }
 #: Sensor plugins by filename: ``create(ctx, sensor, plugin_element, params)`` with ``sensor`` a
-#: :class:`~diffbot_sim.plugins.tags.SensorElement` (its type, link, element and path). One line per module.
+#: :class:`~diffbot_sim.description.plugin_tags.SensorElement` (its type, link, element and path). One line per module.
 SENSOR_PLUGINS = {
     "libgazebo_ros_imu_sensor.so": imu.create_sensor,
     "libgazebo_ros_laser.so": create_laser,
@@ -53,7 +53,7 @@ def _add(ctx, plugins, factory, *args):
 
 def build(ctx, found, params):
     """Every plugin of one robot, in model order, plus the transmission motors no plugin owns and the
-    optional ground truth. ``found`` is the model's :class:`~diffbot_sim.plugins.tags.Plugins`.
+    optional ground truth. ``found`` is the model's :class:`~diffbot_sim.description.plugin_tags.Plugins`.
 
     Raises:
         DiffbotSimError: a plugin whose tags or parameters cannot be used (naming them).

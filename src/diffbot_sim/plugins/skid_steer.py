@@ -5,7 +5,7 @@ tags ``leftFrontJoint``... ``torque``, ``broadcastTF`` (default false); odometry
 with covariances ``covariance_x/y/yaw`` (1e-4, 1e-4, 0.01); no acceleration limit, no timeout.
 """
 from diffbot_sim import config as cfgmod
-from diffbot_sim.model import tag_value
+from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.plugins.diff_drive import DiffDrive
 
 #: Tags the ROS 1 plugin has (or had) that change nothing here.

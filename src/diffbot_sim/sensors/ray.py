@@ -24,8 +24,8 @@ import numpy as np
 
 from diffbot_sim.config import _bool, _number
 from diffbot_sim.errors import ConfigError
-from diffbot_sim.tag_values import tag_number
-from diffbot_sim.model import tag_value
+from diffbot_sim.values import tag_number
+from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.transforms import rpy_matrix
 
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Tuple
 
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.tag_values import tag_number
+from diffbot_sim.values import tag_number
 
 #: Per-link ``<gazebo reference>`` tags that carry a number (ODE surface and contact parameters).
 SURFACE_NUMBERS = ("mu1", "mu2", "kp", "kd", "minDepth", "maxVel", "laserRetro")

@@ -6,8 +6,8 @@ in (sim seconds); the simulator alone owns it.
 """
 import math
 
-from diffbot_sim.kinematics import wheel_speeds
-from diffbot_sim.limits import ramp, scale_to_limit
+from diffbot_sim.control.kinematics import wheel_speeds
+from diffbot_sim.control.limits import ramp, scale_to_limit
 
 TWIST_FIELDS = ("linear.x", "linear.y", "linear.z", "angular.x", "angular.y", "angular.z")
 

@@ -1,7 +1,7 @@
 """A world's static geometry as rviz markers (pure: plain data, no rospy, no message classes).
 
 Gazebo draws the world in its own window; a headless simulator has none, so rviz must draw it. Each static
-collision shape of a :class:`diffbot_sim.world.WorldDescription` becomes one :class:`MarkerSpec` posed in
+collision shape of a :class:`diffbot_sim.world.bodies.WorldDescription` becomes one :class:`MarkerSpec` posed in
 the world frame, which :func:`diffbot_sim.nodes.world_markers.make_marker_array` turns into a
 ``visualization_msgs/MarkerArray``. Collision shapes, not visuals: the reader keeps no visuals, and the
 collision geometry is what the robot and its sensors meet, so it is what a user checks against a scan.
@@ -14,7 +14,7 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from diffbot_sim.world_sdf import compose
+from diffbot_sim.transforms import compose
 
 #: Colour of shapes whose world gives none (rviz rgba, 0..1): light grey, visible on rviz's dark background.
 DEFAULT_COLOR = (0.7, 0.7, 0.72, 1.0)
@@ -49,7 +49,7 @@ def marker_specs(world, warnings=None, max_triangles=MAX_TRIANGLES):
     """Every static shape of ``world`` as :class:`MarkerSpec` (world frame).
 
     Args:
-        world: a :class:`diffbot_sim.world.WorldDescription`.
+        world: a :class:`diffbot_sim.world.bodies.WorldDescription`.
         warnings: a list that gets one line per thing left out (triangles past ``max_triangles``).
         max_triangles: map-wall triangles drawn at most (see MAX_TRIANGLES).
 

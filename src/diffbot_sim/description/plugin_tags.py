@@ -6,12 +6,14 @@ remapping. Both are turned into one dict of canonical snake_case keys holding on
 defaults and validation live in :mod:`diffbot_sim.config`, so a tag, a ROS parameter and a default are
 merged in one place.
 """
+import math
 import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional
 
-from diffbot_sim.errors import ModelError
+from diffbot_sim.description.urdf_model import tag_value
+from diffbot_sim.errors import ConfigError, ModelError
 
 DIFF_DRIVE = "libgazebo_ros_diff_drive.so"
 JOINT_STATE = "libgazebo_ros_joint_state_publisher.so"
@@ -212,3 +214,19 @@ def _read_ros_block(el, block, topics):
 
 def _split_names(text):
     return [name for name in re.split(r"[\s,]+", text) if name]
+
+
+def read_tags(element):
+    """{tag: text} of a plugin element's direct children (both ``<a>v</a>`` and ``<a value="v"/>``)."""
+    return {child.tag: tag_value(child) for child in element} if element is not None else {}
+
+
+def vector(text, where, tag, count=3):
+    """``count`` finite numbers from a tag's text."""
+    try:
+        values = tuple(float(v) for v in str(text).split())
+    except ValueError:
+        values = ()
+    if len(values) != count or not all(math.isfinite(v) for v in values):
+        raise ConfigError(f"<{tag}> of {where}", text, f"{count} finite numbers")
+    return values

@@ -42,7 +42,7 @@ import numpy as np
 import yaml
 
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.world import IDENTITY, Body, Shape, WorldDescription
+from diffbot_sim.world.bodies import IDENTITY, Body, Shape, WorldDescription
 
 #: The keys map_server requires (main.cpp exits when one is missing).
 REQUIRED_KEYS = ("image", "resolution", "origin", "negate", "occupied_thresh", "free_thresh")
@@ -414,7 +414,7 @@ def synthetic_map(path, size=4000, seed=0, room=200, wall=10, door=40, noise=0.0
     pixels = np.where(occupied, 0, 254).astype(np.uint8)
     image = os.path.splitext(path)[0] + ".pgm"
     with open(image, "wb") as stream:
-        stream.write(b"P5\n# diffbot_sim.world_map.synthetic_map\n%d %d\n255\n" % (size, size))
+        stream.write(b"P5\n# diffbot_sim.world.map_image.synthetic_map\n%d %d\n255\n" % (size, size))
         stream.write(pixels.tobytes())
     half = size * resolution / 2.0
     with open(path, "w", encoding="utf-8") as stream:

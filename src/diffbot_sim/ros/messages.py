@@ -157,7 +157,7 @@ class ImageBuilder:
 
 
 def camera_info(frame, intrinsics):
-    """sensor_msgs/CameraInfo from :class:`diffbot_sim.camera_sensor.Intrinsics` (set its stamp per image)."""
+    """sensor_msgs/CameraInfo from :class:`diffbot_sim.sensors.camera.Intrinsics` (set its stamp per image)."""
     msg = CameraInfo(height=intrinsics.height, width=intrinsics.width,
                      distortion_model=intrinsics.distortion_model, D=list(intrinsics.D), K=list(intrinsics.K),
                      R=list(intrinsics.R), P=list(intrinsics.P))

@@ -16,7 +16,7 @@ import re
 from xml.parsers import expat
 from xml.sax.saxutils import escape
 
-from diffbot_sim.world_sdf import compose, inverse, rotate, rpy_quaternion
+from diffbot_sim.transforms import compose, inverse, rotate, rpy_quaternion
 
 IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 

@@ -14,11 +14,12 @@ from dataclasses import dataclass, field
 from typing import List, Optional, Tuple
 
 from diffbot_sim import config as cfgmod
-from diffbot_sim import ddc, meshes
-from diffbot_sim.controllers import find_controllers
-from diffbot_sim.description import load_file, parse_args
-from diffbot_sim.model import parse_urdf, tag_value
-from diffbot_sim.plugins.tags import DIFF_DRIVE, JOINT_STATE, read_plugins
+from diffbot_sim.control import diff_drive_controller as ddc
+from diffbot_sim.description import meshes
+from diffbot_sim.control.controller_lookup import find_controllers
+from diffbot_sim.description.model_files import load_file, parse_args
+from diffbot_sim.description.urdf_model import parse_urdf, tag_value
+from diffbot_sim.description.plugin_tags import DIFF_DRIVE, JOINT_STATE, read_plugins
 
 SKID_STEER = "libgazebo_ros_skid_steer_drive.so"
 PLANAR_MOVE = "libgazebo_ros_planar_move.so"
@@ -370,7 +371,7 @@ def _mm(value):
 
 
 def format_rest(rest):
-    """Lines for the body at rest before driving (a :class:`diffbot_sim.drive_check.Rest`)."""
+    """Lines for the body at rest before driving (a :class:`diffbot_sim.check.drive_check.Rest`)."""
     expected = "" if rest.expected is None else f" (its geometry rests at {_mm(rest.expected)} m)"
     lines = [f"at rest (ground truth): height {_mm(rest.height)} m{expected}, tilt {rest.tilt:.3f} rad, "
              f"height varied {rest.spread:.3f} m: {'PASS' if rest.passed else 'FAIL'}"]
@@ -379,7 +380,7 @@ def format_rest(rest):
 
 
 def _format_ride(ride):
-    """Lines for the body during a motion (a :class:`diffbot_sim.drive_check.Ride`)."""
+    """Lines for the body during a motion (a :class:`diffbot_sim.check.drive_check.Ride`)."""
     lines = [f"  body (ground truth): height {_mm(ride.low)}..{_mm(ride.high)} m, tilt up to {ride.tilt:.3f} rad: "
              f"{'PASS' if ride.passed else 'FAIL'}"]
     lines.extend(f"    {text}" for text in ride.failures)
@@ -387,8 +388,8 @@ def _format_ride(ride):
 
 
 def format_motions(straight, turn, straight_body=None, turn_body=None):
-    """Lines for the two judged motions (:mod:`diffbot_sim.drive_check` results) and, when given, the body
-    during each (:class:`~diffbot_sim.drive_check.Ride`); ``straight``/``turn`` may be None when the motion
+    """Lines for the two judged motions (:mod:`diffbot_sim.check.drive_check` results) and, when given, the body
+    during each (:class:`~diffbot_sim.check.drive_check.Ride`); ``straight``/``turn`` may be None when the motion
     could not be run."""
     lines = []
     if straight is not None:

@@ -1,4 +1,4 @@
-"""Read a Gazebo-classic SDF world (``.world``) into a :class:`diffbot_sim.world.WorldDescription` (pure).
+"""Read a Gazebo-classic SDF world (``.world``) into a :class:`diffbot_sim.world.bodies.WorldDescription` (pure).
 
 Why our own reader: ``pybullet.loadSDF`` has no ``<include>``, mishandles ``<static>true</static>``, turns
 meshes into convex hulls and does not import jointless multi-link models; libsdformat is not on Debian's
@@ -9,7 +9,7 @@ What is read (SDF 1.4 to 1.9, as Gazebo 11 reads them):
 
 * ``<model>`` (inline, nested as ``outer::inner``) and ``<include>`` (``uri``; ``name``, ``pose`` and
   ``static`` override the included model's, an empty ``<pose/>`` resets it to zero; also inside a model).
-  Each ``<link>`` becomes one :class:`~diffbot_sim.world.Body` named ``model::link``; joints between links
+  Each ``<link>`` becomes one :class:`~diffbot_sim.world.bodies.Body` named ``model::link``; joints between links
   are named in one warning per model and not simulated (the links move as separate bodies).
 * ``<collision>`` geometry box, cylinder, sphere, plane (infinite), mesh; surface ``mu``/``mu2`` (ODE, else
   Bullet), contact ``kp``/``kd`` and ``laser_retro``. Of visuals only the colour is read, for cameras: the
@@ -33,16 +33,16 @@ import os
 import xml.etree.ElementTree as ET
 
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.tag_values import tag_number
-from diffbot_sim.transforms import qmul as _qmul
-from diffbot_sim.world import IDENTITY, Body, Shape, WorldDescription
+from diffbot_sim.values import tag_number
+from diffbot_sim.transforms import compose, inverse, qnormalize, rpy_quaternion
+from diffbot_sim.world.bodies import IDENTITY, Body, Shape, WorldDescription
 
 #: The SDF versions this reader knows; others are read as the nearest one (with a warning).
 VERSIONS = ((1, 4), (1, 5), (1, 6), (1, 7), (1, 8), (1, 9))
 #: The parser's own version: ``model.config`` entries newer than this are skipped, as libsdformat does.
 PARSER_VERSION = VERSIONS[-1]
 
-#: Mesh formats the physics layer can read (:mod:`diffbot_sim.meshes`).
+#: Mesh formats the physics layer can read (:mod:`diffbot_sim.description.meshes`).
 MESH_EXTENSIONS = (".dae", ".stl", ".obj")
 
 # Gazebo installs exactly these two models with itself "to make Gazebo run without an internet
@@ -75,49 +75,6 @@ GAZEBO_COLORS = {
 # World children that change nothing our physics does: named once in ``not_simulated``.
 _WORLD_NOT_SIMULATED = ("scene", "gui", "atmosphere", "magnetic_field", "spherical_coordinates", "wind",
                         "audio")
-
-
-# ------------------------------------------------------------------------------------------ pose math
-
-def _qnorm(q):
-    n = math.sqrt(sum(c * c for c in q))
-    return tuple(c / n for c in q)
-
-
-def rotate(q, v):
-    """Vector ``v`` turned by the unit quaternion ``q`` (x, y, z, w)."""
-    x, y, z, w = q
-    # v + 2 w (u x v) + 2 u x (u x v), with u the vector part: no matrix needed.
-    cx, cy, cz = y * v[2] - z * v[1], z * v[0] - x * v[2], x * v[1] - y * v[0]
-    return (v[0] + 2 * (w * cx + y * cz - z * cy),
-            v[1] + 2 * (w * cy + z * cx - x * cz),
-            v[2] + 2 * (w * cz + x * cy - y * cx))
-
-
-def compose(a, b):
-    """``a * b``: pose ``b`` (given in frame ``a``) expressed in ``a``'s parent frame."""
-    (pa, qa), (pb, qb) = a, b
-    p = rotate(qa, pb)
-    return ((pa[0] + p[0], pa[1] + p[1], pa[2] + p[2]), _qnorm(_qmul(qa, qb)))
-
-
-def inverse(a):
-    """The pose that undoes ``a``: ``compose(a, inverse(a)) == IDENTITY``."""
-    p, (x, y, z, w) = a
-    qi = (-x, -y, -z, w)
-    r = rotate(qi, p)
-    return ((-r[0], -r[1], -r[2]), qi)
-
-
-def rpy_quaternion(roll, pitch, yaw):
-    """SDF's fixed-axis roll, pitch, yaw (R = Rz(yaw) Ry(pitch) Rx(roll)) -> quaternion (x, y, z, w)."""
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (sr * cp * cy - cr * sp * sy,
-            cr * sp * cy + sr * cp * sy,
-            cr * cp * sy - sr * sp * cy,
-            cr * cp * cy + sr * sp * sy)
 
 
 def _clean(pose):
@@ -368,7 +325,7 @@ class _Reader:
             v = self.floats(text, 7, src, path, "<pose> (quat_xyzw)")
             if sum(c * c for c in v[3:]) < 1e-12:
                 raise ModelError("<pose> quaternion is zero", src.path, path)
-            return ((v[0], v[1], v[2]), _qnorm(v[3:])), rel
+            return ((v[0], v[1], v[2]), qnormalize(v[3:])), rel
         if fmt != "euler_rpy":
             raise ModelError(f"<pose rotation_format='{fmt}'> is not euler_rpy or quat_xyzw", src.path, path)
         v = self.floats(text, 6, src, path, "<pose>")
@@ -961,7 +918,7 @@ def read_world(path, model_paths=None, package_model_paths=None):
         package_model_paths: directories searched after those, e.g. :func:`ros_package_model_paths`.
 
     Returns:
-        a :class:`~diffbot_sim.world.WorldDescription`: bodies in the order of the file, link-frame world
+        a :class:`~diffbot_sim.world.bodies.WorldDescription`: bodies in the order of the file, link-frame world
         poses (after the first ``<state>``), shapes posed in their link frames, mesh paths absolute.
 
     Raises:

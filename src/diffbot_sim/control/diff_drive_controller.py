@@ -12,9 +12,9 @@ from dataclasses import asdict, dataclass, field
 from typing import NamedTuple, Optional, Tuple
 
 from diffbot_sim.errors import ConfigError
-from diffbot_sim.kinematics import wheel_speeds
-from diffbot_sim.limits import SpeedLimiter
-from diffbot_sim.odometry import EncoderOdometry
+from diffbot_sim.control.kinematics import wheel_speeds
+from diffbot_sim.control.limits import SpeedLimiter
+from diffbot_sim.control.odometry import EncoderOdometry
 
 CONTROLLER_TYPE = "diff_drive_controller/DiffDriveController"
 

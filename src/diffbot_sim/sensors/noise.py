@@ -22,7 +22,7 @@ import random
 import zlib
 
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.tag_values import tag_number
+from diffbot_sim.values import tag_number
 
 SDF_KINDS = ("none", "gaussian", "gaussian_quantized")
 

@@ -1,10 +1,10 @@
-"""A world as plain data (pure): what the SDF reader (:mod:`diffbot_sim.world_sdf`) and the map-image
-converter (:mod:`diffbot_sim.world_map`) produce and the physics layer builds.
+"""A world as plain data (pure): what the SDF reader (:mod:`diffbot_sim.world.sdf_reader`) and the map-image
+converter (:mod:`diffbot_sim.world.map_image`) produce and the physics layer builds.
 
 Every pose is ``(xyz, quaternion xyzw)`` with plain float tuples. A body is one SDF ``<link>`` (a model with
 several links gives several bodies; joints between them are not simulated and are named in ``warnings``).
 Mesh shapes carry the mesh file's absolute path and its scale; the physics layer converts and caches them
-(:mod:`diffbot_sim.meshes`), so COLLADA units are honoured as for robots.
+(:mod:`diffbot_sim.description.meshes`), so COLLADA units are honoured as for robots.
 """
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Tuple

@@ -23,11 +23,13 @@ from geometry_msgs.msg import Pose, Twist, Vector3
 from std_msgs.msg import Header
 from std_srvs.srv import Empty
 
-from diffbot_sim import meshes, world_api
-from diffbot_sim.description import package_path
+from diffbot_sim.description import meshes
+
+from diffbot_sim.gazebo import world_api
+from diffbot_sim.description.model_files import package_path
 from diffbot_sim.errors import DiffbotSimError
 from diffbot_sim.plugins.base import close_handle, publisher
-from diffbot_sim.world_sdf import compose, inverse
+from diffbot_sim.transforms import compose, inverse
 
 #: Time a spawn may take on the loop (mesh conversion of a large model), before the caller gives up.
 SPAWN_TIMEOUT = 60.0
@@ -318,7 +320,7 @@ class GazeboApi:
 
     def _spawn_sdf(self, name, text, pose):
         """An SDF model becomes world bodies: the model's pose replaced by the request's, as Gazebo does."""
-        from diffbot_sim.world_sdf import read_world, ros_package_model_paths
+        from diffbot_sim.world.sdf_reader import read_world, ros_package_model_paths
         model_xml = world_api.sdf_model_at(text, pose)
         with tempfile.TemporaryDirectory(prefix="spawn_sdf_") as tmp:
             path = os.path.join(tmp, f"{name}.world")

@@ -1,0 +1,1 @@
+"""The sensors' models: ray sensors (lasers, rangers, clouds), cameras, noise. Pure: no rospy."""

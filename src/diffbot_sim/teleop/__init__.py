@@ -1,0 +1,1 @@
+"""The keyboard teleop: key map, terminal, status line. Pure: no rospy."""

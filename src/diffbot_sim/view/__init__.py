@@ -1,0 +1,1 @@
+"""Seeing a run: the rviz config, plot data and headless X screens. Pure: no rospy."""
