@@ -16,7 +16,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "src"))
 
-from diffbot_sim.description import meshes  # noqa: E402
+from diffbot_sim.description import mesh_formats, meshes  # noqa: E402
 
 RECORD = np.dtype([("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attribute", "<u2")])
 
@@ -80,7 +80,7 @@ def main():
             return meshes.prepare_meshes(URDF, "speed.urdf", root, cache, package)
 
         print(f"mesh: {os.path.getsize(stl)} bytes binary STL, 40000 triangles")
-        t_read, (vertices, faces) = best(lambda: meshes.read_stl(stl), args.repeat)
+        t_read, (vertices, faces) = best(lambda: mesh_formats.read_stl(stl), args.repeat)
         print(f"read_stl (frombuffer + weld): {t_read * 1000:.1f} ms -> {len(vertices)} vertices")
         t_cold, (text, _) = best(cold, args.repeat)
         obj = text.split('filename="')[1].split('"')[0]

@@ -5,12 +5,11 @@ the model's ``<gazebo><plugin>`` tags (read by :mod:`diffbot_sim.plugins`), and 
 parameters. Every bad value raises ``ConfigError`` naming the parameter (``~time_step``) or the tag and the
 plugin element it stands in; a model that contradicts itself raises ``ModelError``.
 """
-import math
 from dataclasses import asdict, dataclass, field, fields
 from typing import List, Optional
 
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.values import tag_number
+from diffbot_sim.values import check_bool, check_number, check_string, tag_number
 
 #: Wheel speed cap [rad/s] when neither ``~max_wheel_velocity`` nor the URDF ``<limit velocity>`` gives one:
 #: keeps a 1e308 command from reaching the physics as an absurd motor target.
@@ -115,10 +114,10 @@ def skid_steer_config(model, values, path, notes=None):
         if key in ("left_front", "left_rear", "right_front", "right_rear"):
             continue
         setattr(cfg, key, _drive_value(key, value, label, notes))
-    cfg.left_joints = [_string(f"<leftFrontJoint> of {path}", merged["left_front"]),
-                       _string(f"<leftRearJoint> of {path}", merged["left_rear"])]
-    cfg.right_joints = [_string(f"<rightFrontJoint> of {path}", merged["right_front"]),
-                        _string(f"<rightRearJoint> of {path}", merged["right_rear"])]
+    cfg.left_joints = [check_string(f"<leftFrontJoint> of {path}", merged["left_front"]),
+                       check_string(f"<leftRearJoint> of {path}", merged["left_rear"])]
+    cfg.right_joints = [check_string(f"<rightFrontJoint> of {path}", merged["right_front"]),
+                        check_string(f"<rightRearJoint> of {path}", merged["right_rear"])]
     for jname in cfg.left_joints + cfg.right_joints:
         joint = model.joint(jname, path)
         if not joint.movable:
@@ -168,33 +167,33 @@ def sim_config(params):
         if key in known:
             setattr(cfg, key, value)
     name = lambda k: f"~{k}"  # noqa: E731
-    cfg.model = _string(name("model"), cfg.model, allow_empty=True)
-    cfg.model_args = _string(name("model_args"), cfg.model_args, allow_empty=True)
+    cfg.model = check_string(name("model"), cfg.model, allow_empty=True)
+    cfg.model_args = check_string(name("model_args"), cfg.model_args, allow_empty=True)
     if not params.get("world") and params.get("world_name"):
         cfg.world = params["world_name"]  # gazebo_ros's empty_world.launch calls it world_name
-    cfg.world = _string(name("world"), cfg.world, allow_empty=True)
-    cfg.map_wall_height = _number(name("map_wall_height"), cfg.map_wall_height, low=0.0, low_open=True)
-    seed = _number(name("seed"), cfg.seed)
+    cfg.world = check_string(name("world"), cfg.world, allow_empty=True)
+    cfg.map_wall_height = check_number(name("map_wall_height"), cfg.map_wall_height, low=0.0, low_open=True)
+    seed = check_number(name("seed"), cfg.seed)
     if seed != int(seed):
         raise ConfigError(name("seed"), params.get("seed"), "an integer")
     cfg.seed = int(seed)
-    cfg.renderer = _string(name("renderer"), cfg.renderer).lower()
+    cfg.renderer = check_string(name("renderer"), cfg.renderer).lower()
     if cfg.renderer not in ("tiny", "egl"):
         raise ConfigError(name("renderer"), cfg.renderer, "tiny or egl")
-    cfg.gazebo_namespace = "/" + _string(name("gazebo_namespace"), cfg.gazebo_namespace).strip("/")
-    cfg.physics_engine = _string(name("physics_engine"), cfg.physics_engine, allow_empty=True)
+    cfg.gazebo_namespace = "/" + check_string(name("gazebo_namespace"), cfg.gazebo_namespace).strip("/")
+    cfg.physics_engine = check_string(name("physics_engine"), cfg.physics_engine, allow_empty=True)
     for key in ("gui", "real_time", "debug_cmd_applied", "publish_ground_truth", "paused",
                 "autostart_controllers", "enable_ros_network"):
-        setattr(cfg, key, _bool(name(key), getattr(cfg, key)))
-    cfg.time_step = _number(name("time_step"), cfg.time_step, low=1e-5, high=0.05)
-    cfg.real_time_factor = _number(name("real_time_factor"), cfg.real_time_factor, low=1e-3)
-    cfg.clock_rate = _number(name("clock_rate"), cfg.clock_rate, low=1e-3)
-    cfg.fast_batch = _number(name("fast_batch"), cfg.fast_batch, low=0.0, high=0.1)
-    cfg.send_timeout = _number(name("send_timeout"), cfg.send_timeout, low=0.01)
-    cfg.cmd_vel_timeout = _number(name("cmd_vel_timeout"), cfg.cmd_vel_timeout, low=0.0)
-    cfg.max_wheel_velocity = _number(name("max_wheel_velocity"), cfg.max_wheel_velocity, low=0.0)
+        setattr(cfg, key, check_bool(name(key), getattr(cfg, key)))
+    cfg.time_step = check_number(name("time_step"), cfg.time_step, low=1e-5, high=0.05)
+    cfg.real_time_factor = check_number(name("real_time_factor"), cfg.real_time_factor, low=1e-3)
+    cfg.clock_rate = check_number(name("clock_rate"), cfg.clock_rate, low=1e-3)
+    cfg.fast_batch = check_number(name("fast_batch"), cfg.fast_batch, low=0.0, high=0.1)
+    cfg.send_timeout = check_number(name("send_timeout"), cfg.send_timeout, low=0.01)
+    cfg.cmd_vel_timeout = check_number(name("cmd_vel_timeout"), cfg.cmd_vel_timeout, low=0.0)
+    cfg.max_wheel_velocity = check_number(name("max_wheel_velocity"), cfg.max_wheel_velocity, low=0.0)
     for key in ("gravity", "x", "y", "z", "yaw"):
-        setattr(cfg, key, _number(name(key), getattr(cfg, key)))
+        setattr(cfg, key, check_number(name(key), getattr(cfg, key)))
     return cfg
 
 
@@ -266,7 +265,7 @@ def joint_state_config(model, block, drive, notes=None):
             elif key == "update_rate":
                 cfg.update_rate = tag_number(label, value, notes if notes is not None else [], low=0.0)
             elif key in ("topic", "namespace"):
-                setattr(cfg, key, _string(label, value, allow_empty=key == "namespace"))
+                setattr(cfg, key, check_string(label, value, allow_empty=key == "namespace"))
         for jname in cfg.joints:
             model.joint(jname, block.path)
     if drive is not None and drive.publish_wheel_joint_state:
@@ -311,11 +310,11 @@ def robot_specs(sim, params):
         spec = RobotSpec()
         spec.name = _ros_name(f"{label}.name", entry.get("name"))
         for key in ("model", "model_args"):  # an entry without its own model shares ~model
-            setattr(spec, key, _string(f"{label}.{key}", entry.get(key, getattr(sim, key)), allow_empty=True))
+            setattr(spec, key, check_string(f"{label}.{key}", entry.get(key, getattr(sim, key)), allow_empty=True))
         for key in ("x", "y", "z", "yaw"):
-            setattr(spec, key, _number(f"{label}.{key}", entry.get(key, 0.0)))
+            setattr(spec, key, check_number(f"{label}.{key}", entry.get(key, 0.0)))
         if entry.get("tf_prefix") is not None:
-            spec.tf_prefix = _string(f"{label}.tf_prefix", entry["tf_prefix"], allow_empty=True).strip("/")
+            spec.tf_prefix = check_string(f"{label}.tf_prefix", entry["tf_prefix"], allow_empty=True).strip("/")
         for j, other in enumerate(specs):
             if other.name == spec.name:
                 raise ConfigError(f"{label}.name", spec.name, f"a name not already used by ~robots[{j}]")
@@ -385,7 +384,7 @@ def _drive_value(key, value, label, notes, from_tag=False):
     that warning to ``notes``. A number ``from_tag`` (a plugin tag's text) is read as Gazebo reads it: its
     leading number (:func:`diffbot_sim.values.tag_number`)."""
     def number(**limits):
-        return tag_number(label, value, notes, **limits) if from_tag else _number(label, value, **limits)
+        return tag_number(label, value, notes, **limits) if from_tag else check_number(label, value, **limits)
 
     if key in ("left_joints", "right_joints"):
         names = [value] if isinstance(value, str) else value
@@ -402,7 +401,7 @@ def _drive_value(key, value, label, notes, from_tag=False):
     if key in ("covariance_x", "covariance_y", "covariance_yaw"):
         return number(low=0.0)
     if key in ("publish_odom", "publish_odom_tf", "publish_wheel_joint_state"):
-        return _bool(label, value)
+        return check_bool(label, value)
     if key == "odometry_source":
         text = str(value).strip()
         mapped = {"0": "encoder", "1": "world", "encoder": "encoder", "world": "world"}.get(text)
@@ -414,24 +413,8 @@ def _drive_value(key, value, label, notes, from_tag=False):
             return "world"
         return mapped
     if key == "namespace":
-        return _string(label, value, allow_empty=True)
-    return _string(label, value)
-
-
-def _number(name, value, low=None, high=None, low_open=False):
-    if isinstance(value, bool):
-        raise ConfigError(name, value, "a number")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ConfigError(name, value, "a number") from None
-    if not math.isfinite(number):
-        raise ConfigError(name, value, "a finite number")
-    if low is not None and (number < low or (low_open and number == low)):
-        raise ConfigError(name, value, f"a number {'>' if low_open else '>='} {low:g}")
-    if high is not None and number > high:
-        raise ConfigError(name, value, f"a number <= {high:g}")
-    return number
+        return check_string(label, value, allow_empty=True)
+    return check_string(label, value)
 
 
 def _ros_name(name, value):
@@ -443,18 +426,3 @@ def _ros_name(name, value):
     return text
 
 
-def _bool(name, value):
-    if isinstance(value, bool):
-        return value
-    text = str(value).strip().lower()
-    if text in ("true", "1"):
-        return True
-    if text in ("false", "0"):
-        return False
-    raise ConfigError(name, value, "true or false")
-
-
-def _string(name, value, allow_empty=False):
-    if not isinstance(value, str) or (not allow_empty and not value.strip()):
-        raise ConfigError(name, value, "a non-empty string" if not allow_empty else "a string")
-    return value.strip()

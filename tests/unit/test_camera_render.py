@@ -90,6 +90,6 @@ def test_egl_probe_reports_a_plugin_that_ends_its_process(monkeypatch):
     a reason (this is what happened in a fresh debootstrap chroot, where it used to end pytest itself)."""
     from diffbot_sim import physics
 
-    monkeypatch.setattr(physics, "_EGL_PROBE", "import sys; sys.exit(1)\n")
+    monkeypatch.setattr(physics.client, "_EGL_PROBE", "import sys; sys.exit(1)\n")
     reason = physics.egl_probe("/any/plugin.so")
     assert "ended its process" in reason and "status 1" in reason

@@ -11,7 +11,7 @@ import numpy as np
 import pybullet
 import pytest
 
-from diffbot_sim.description import meshes
+from diffbot_sim.description import mesh_formats, meshes
 from diffbot_sim.errors import ModelError
 
 # A box 1000 x 1000 x 500 (mm), centred on the origin: 8 corners, 12 outward-wound triangles.
@@ -135,7 +135,7 @@ def tri_expected_mm():
 
 
 def test_read_dae_applies_unit_and_node_transforms_and_ignores_up_axis(tmp_path):
-    vertices, faces = meshes.read_dae(write_dae(tmp_path / "m.dae"))
+    vertices, faces = mesh_formats.read_dae(write_dae(tmp_path / "m.dae"))
     expected = np.array(block_expected_mm() + tri_expected_mm()) * 0.001
     assert sorted(map(tuple, np.round(vertices, 9))) == sorted(map(tuple, np.round(expected, 9)))
     assert len(faces) == 6 * 2 + 1  # 6 quads fanned into 2 triangles each, plus the triangle
@@ -146,27 +146,27 @@ def test_read_dae_applies_unit_and_node_transforms_and_ignores_up_axis(tmp_path)
 
 
 def test_read_dae_can_honour_y_up_and_x_up(tmp_path):
-    base, _ = meshes.read_dae(write_dae(tmp_path / "m.dae"))
-    y_up, _ = meshes.read_dae(str(tmp_path / "m.dae"), honour_up_axis=True)
+    base, _ = mesh_formats.read_dae(write_dae(tmp_path / "m.dae"))
+    y_up, _ = mesh_formats.read_dae(str(tmp_path / "m.dae"), honour_up_axis=True)
     # Y_UP: (x, y, z) -> (x, -z, y): (-0.09, 0.22, 0.08) -> (-0.09, -0.08, 0.22)
     assert np.allclose(y_up, base[:, [0, 2, 1]] * [1, -1, 1])
     assert np.isclose(y_up, [-0.09, -0.08, 0.22]).all(axis=1).any()
-    x_up, _ = meshes.read_dae(write_dae(tmp_path / "x.dae", up="X_UP"), honour_up_axis=True)
+    x_up, _ = mesh_formats.read_dae(write_dae(tmp_path / "x.dae", up="X_UP"), honour_up_axis=True)
     # X_UP: (x, y, z) -> (-z, y, x)
     assert np.allclose(x_up, np.stack([-base[:, 2], base[:, 1], base[:, 0]], axis=1))
-    z_up, _ = meshes.read_dae(write_dae(tmp_path / "z.dae", up="Z_UP"), honour_up_axis=True)
+    z_up, _ = mesh_formats.read_dae(write_dae(tmp_path / "z.dae", up="Z_UP"), honour_up_axis=True)
     assert np.allclose(z_up, base)
 
 
 def test_read_dae_without_asset_or_namespace_is_metres(tmp_path):
-    vertices, _ = meshes.read_dae(write_dae(tmp_path / "m.dae", unit=None, up=None, namespace=False))
+    vertices, _ = mesh_formats.read_dae(write_dae(tmp_path / "m.dae", unit=None, up=None, namespace=False))
     assert np.isclose(vertices, [-90, 220, 80]).all(axis=1).any()
 
 
 def test_read_dae_mirroring_matrix_keeps_faces_outward(tmp_path):
     mirrored = "-1 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1"
-    plain_v, plain_f = meshes.read_dae(write_dae(tmp_path / "a.dae", matrix="1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1"))
-    mirror_v, mirror_f = meshes.read_dae(write_dae(tmp_path / "b.dae", matrix=mirrored))
+    plain_v, plain_f = mesh_formats.read_dae(write_dae(tmp_path / "a.dae", matrix="1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1"))
+    mirror_v, mirror_f = mesh_formats.read_dae(write_dae(tmp_path / "b.dae", matrix=mirrored))
 
     def volume(v, f):  # signed volume of the closed block: > 0 when faces wind outward
         a, b, c = v[f[:12, 0]], v[f[:12, 1]], v[f[:12, 2]]
@@ -188,7 +188,7 @@ def test_read_dae_polygons_and_instance_node(tmp_path):
         <instance_node url="#lib"/></node></visual_scene></library_visual_scenes>
       <scene><instance_visual_scene url="#vs"/></scene></COLLADA>"""
     (tmp_path / "p.dae").write_text(text)
-    vertices, faces = meshes.read_dae(str(tmp_path / "p.dae"))
+    vertices, faces = mesh_formats.read_dae(str(tmp_path / "p.dae"))
     assert len(faces) == 3  # quad -> 2 (fan) + triangle
     # (x, y, z) cm -> (x + 100, y, z + 5) cm -> m
     assert np.allclose(vertices.min(axis=0), [1.0, 0.0, 0.05])
@@ -209,7 +209,7 @@ def test_read_dae_errors_name_the_file(tmp_path, body, message):
     path = tmp_path / "bad.dae"
     path.write_text(body)
     with pytest.raises(ModelError, match=message) as info:
-        meshes.read_dae(str(path))
+        mesh_formats.read_dae(str(path))
     assert str(path) in str(info.value)
 
 
@@ -218,7 +218,7 @@ def test_read_dae_errors_name_the_file(tmp_path, body, message):
 @pytest.mark.parametrize("writer", [write_binary_stl, write_ascii_stl])
 def test_read_stl_binary_and_ascii(tmp_path, writer):
     path = writer(tmp_path / "box.stl", box_triangles())
-    vertices, faces = meshes.read_stl(path)
+    vertices, faces = mesh_formats.read_stl(path)
     assert vertices.dtype == np.float64 and faces.shape == (12, 3)
     assert len(vertices) == 8  # corners shared between triangles are welded
     assert triangles_of(vertices, faces) == triangles_of(box_corners(), np.array(BOX_FACES))
@@ -227,7 +227,7 @@ def test_read_stl_binary_and_ascii(tmp_path, writer):
 def test_read_stl_binary_whose_header_says_solid(tmp_path):
     """SolidWorks writes binary STL starting with "solid"; the size tells them apart."""
     path = write_binary_stl(tmp_path / "sw.stl", box_triangles(), header=b"solid part exported")
-    vertices, faces = meshes.read_stl(path)
+    vertices, faces = mesh_formats.read_stl(path)
     assert len(faces) == 12 and np.allclose(vertices.max(axis=0), BOX_HALF)
 
 
@@ -236,11 +236,11 @@ def test_read_stl_truncated_and_garbage(tmp_path):
     with open(path, "r+b") as handle:
         handle.truncate(84 + 50 * 5)
     with pytest.raises(ModelError, match=r"truncated.*12 triangles") as info:
-        meshes.read_stl(path)
+        mesh_formats.read_stl(path)
     assert path in str(info.value)
     (tmp_path / "tiny.stl").write_bytes(b"hello")
     with pytest.raises(ModelError, match="not an STL"):
-        meshes.read_stl(str(tmp_path / "tiny.stl"))
+        mesh_formats.read_stl(str(tmp_path / "tiny.stl"))
 
 
 def test_read_obj_polygons_slashes_negative_indices(tmp_path):
@@ -249,7 +249,7 @@ def test_read_obj_polygons_slashes_negative_indices(tmp_path):
                     "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n"
                     "f 1/1/1 2/1/1 3/1/1 4/1/1\n"
                     "v 0 0 2\nf -5//1 -4//1 -1//1\n")
-    vertices, faces = meshes.read_obj(str(path))
+    vertices, faces = mesh_formats.read_obj(str(path))
     assert vertices.shape == (5, 3) and vertices[4].tolist() == [0, 0, 2]
     assert faces.tolist() == [[0, 1, 2], [0, 2, 3], [0, 1, 4]]
 
@@ -258,16 +258,16 @@ def test_read_obj_errors_name_file_and_line(tmp_path):
     path = tmp_path / "bad.obj"
     path.write_text("v 0 0 0\nv 1 0\n")
     with pytest.raises(ModelError, match=r"bad.obj: line 2: vertex is not three numbers"):
-        meshes.read_obj(str(path))
+        mesh_formats.read_obj(str(path))
     path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n")
     with pytest.raises(ModelError, match="does not exist"):
-        meshes.read_obj(str(path))
+        mesh_formats.read_obj(str(path))
 
 
 def test_write_obj_round_trip(tmp_path):
     vertices, faces = box_corners() * 0.001, np.array(BOX_FACES)
-    meshes.write_obj(str(tmp_path / "o.obj"), vertices, faces, comment="test")
-    back_v, back_f = meshes.read_obj(str(tmp_path / "o.obj"))
+    mesh_formats.write_obj(str(tmp_path / "o.obj"), vertices, faces, comment="test")
+    back_v, back_f = mesh_formats.read_obj(str(tmp_path / "o.obj"))
     assert np.allclose(back_v, vertices) and (back_f == faces).all()
 
 
@@ -318,7 +318,7 @@ def test_uris_resolve_to_one_cached_obj(model, uri):
     (attrib,) = meshes_of(text)
     assert attrib["scale"] == "0.001 0.001 0.001"  # kept: PyBullet applies it
     assert os.path.dirname(attrib["filename"]) == str(model / "cache") and attrib["filename"].endswith(".obj")
-    vertices, _ = meshes.read_obj(attrib["filename"])
+    vertices, _ = mesh_formats.read_obj(attrib["filename"])
     assert np.allclose(vertices.max(axis=0), BOX_HALF)  # STL numbers as written; the URDF scale does the mm
 
 
@@ -406,8 +406,9 @@ def test_second_start_parses_nothing(model, monkeypatch):
     def boom(*args, **kwargs):
         raise AssertionError("parsed a mesh on a cache hit")
 
+    monkeypatch.setattr(meshes, "read_mesh", boom)  # the converter's one entry to the readers
     for name in ("read_mesh", "read_stl", "read_obj", "read_dae"):
-        monkeypatch.setattr(meshes, name, boom)
+        monkeypatch.setattr(mesh_formats, name, boom)
     second, warnings = prepare(text, model)
     assert second == first and warnings == []
 
@@ -423,7 +424,7 @@ def test_changed_mesh_is_converted_again_and_old_entry_pruned(model):
     second, _ = prepare(text, model)
     new_obj = meshes_of(second)[0]["filename"]
     assert new_obj != old_obj and not os.path.exists(old_obj)
-    assert np.allclose(meshes.read_obj(new_obj)[0].max(axis=0), 1.0)
+    assert np.allclose(mesh_formats.read_obj(new_obj)[0].max(axis=0), 1.0)
     assert [n for n in os.listdir(model / "cache")] == [os.path.basename(new_obj)]  # no temporaries left
 
 

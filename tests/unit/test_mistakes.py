@@ -8,7 +8,7 @@ import pytest
 
 from diffbot_sim import config
 
-from diffbot_sim.description import meshes
+from diffbot_sim.description import mesh_formats, meshes
 from diffbot_sim.description.model_files import load_file
 from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.physics import World
@@ -162,7 +162,7 @@ def test_pybullet_loads_it_with_the_urdf_mass_and_the_mesh_box(loaded):
         index = robot.link_carrier("base_link")  # lumped into the inertia-less root, as Gazebo lumps it
         (shape,) = pybullet.getCollisionShapeData(robot.body, index, physicsClientId=world.client)
         assert shape[2] == pybullet.GEOM_MESH and shape[3] == pytest.approx((0.001, 0.001, 0.001))
-        vertices, _ = meshes.read_obj(shape[4].decode())  # the cached .obj, in the STL's millimetres
+        vertices, _ = mesh_formats.read_obj(shape[4].decode())  # the cached .obj, in the STL's millimetres
         assert vertices.max(axis=0) - vertices.min(axis=0) == pytest.approx([200.0, 150.0, 40.0])
         # The shape sits at base_link's origin, unturned: PyBullet stores it relative to the carrier's inertial
         # frame (turned into the principal axes of base_link + the lumped laser), so compose the two; base_link

@@ -4,7 +4,7 @@ import os
 import pytest
 
 from diffbot_sim.errors import ModelError
-from diffbot_sim.plugins import read_plugins
+from diffbot_sim.description.plugin_tags import read_plugins
 
 
 def _gazebo(*plugins):

@@ -10,7 +10,9 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
+from diffbot_sim.gazebo import model_xml
 from diffbot_sim.gazebo import world_api as api
+from diffbot_sim.gazebo.ignition import IDENTITY, quaternion_rpy
 from diffbot_sim.transforms import compose, rpy_quaternion
 
 S = math.sqrt(0.5)
@@ -143,7 +145,7 @@ def test_set_link_state_convention_subtracts_unrotated():
 
 def test_world_state_unknown_convention():
     with pytest.raises(ValueError, match="convention"):
-        api.world_state(api.IDENTITY, AT_REST, FRAME, AT_REST, convention="tf")
+        api.world_state(IDENTITY, AT_REST, FRAME, AT_REST, convention="tf")
 
 
 # ------------------------------------------------------------------------------------------ checks
@@ -184,12 +186,12 @@ def test_check_twist():
 def test_quaternion_rpy_inverts_rpy_quaternion():
     for rpy in [(0.1, -0.2, 0.3), (0.0, 0.0, math.pi / 2), (-1.0, 1.2, 3.0), (0.0, math.pi / 2, 0.0),
                 (0.3, -math.pi / 2, 0.0)]:
-        assert same_rotation(rpy_quaternion(*api.quaternion_rpy(rpy_quaternion(*rpy))), rpy_quaternion(*rpy))
-    assert close(api.quaternion_rpy(YAW90), (0.0, 0.0, math.pi / 2))
+        assert same_rotation(rpy_quaternion(*quaternion_rpy(rpy_quaternion(*rpy))), rpy_quaternion(*rpy))
+    assert close(quaternion_rpy(YAW90), (0.0, 0.0, math.pi / 2))
     rng = random.Random(3)
     for _ in range(200):
         q = random_pose(rng)[1]
-        assert same_rotation(rpy_quaternion(*api.quaternion_rpy(q)), q)
+        assert same_rotation(rpy_quaternion(*quaternion_rpy(q)), q)
 
 
 # ------------------------------------------------------------------------------------------ URDF text
@@ -218,7 +220,7 @@ def test_prepare_urdf_strips_declaration_and_comments_and_resolves_packages():
                 '</visual></link>\n'
                 '  <link name="w"><visual><geometry><mesh filename="/m/w.dae"/></geometry></visual></link>\n'
                 '</robot>\n')
-    assert api.prepare_urdf(text, resolve) == expected
+    assert model_xml.prepare_urdf(text, resolve) == expected
 
 
 @pytest.mark.parametrize("package", ["missing", "raises"])
@@ -226,26 +228,26 @@ def test_prepare_urdf_unknown_package(package):
     text = f'<robot name="r"><link name="a"><visual><geometry><mesh filename="package://{package}/a.stl"/>' \
            f'</geometry></visual></link></robot>'
     with pytest.raises(ValueError, match=rf"^urdf reference package name does not exist: {package}$"):
-        api.prepare_urdf(text, resolve)
+        model_xml.prepare_urdf(text, resolve)
 
 
 def test_prepare_urdf_without_a_slash_stops_replacing():
     text = '<robot name="r"><x a="package://diffbot_description"></x></robot>'
     # upstream takes the next "/" anywhere (here the one of "</x>"), so the "name" is garbage: unknown
     with pytest.raises(ValueError, match="does not exist"):
-        api.prepare_urdf(text, resolve)
+        model_xml.prepare_urdf(text, resolve)
     tail = '<robot name="r"/><!-- c -->package://diffbot_description'
-    assert api.prepare_urdf(tail, resolve) == '<robot name="r"/>package://diffbot_description'
+    assert model_xml.prepare_urdf(tail, resolve) == '<robot name="r"/>package://diffbot_description'
 
 
 def test_prepare_urdf_unterminated_comment():
     with pytest.raises(ValueError, match="line 2.*never closed"):
-        api.prepare_urdf('<robot name="r">\n<!-- oops\n</robot>', resolve)
+        model_xml.prepare_urdf('<robot name="r">\n<!-- oops\n</robot>', resolve)
 
 
 def test_prepare_urdf_keeps_everything_else():
     text = '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">\n\t<link  name = "a" />\n</robot>'
-    assert api.prepare_urdf(text, resolve) == text
+    assert model_xml.prepare_urdf(text, resolve) == text
 
 
 # ------------------------------------------------------------------------------------------ namespaces
@@ -272,7 +274,7 @@ NS = "<robotNamespace>/r1</robotNamespace>"
 
 
 def test_inject_namespace_urdf_adds_where_missing_and_keeps_an_existing_one():
-    out = api.inject_robot_namespace(URDF, "/r1")
+    out = model_xml.inject_robot_namespace(URDF, "/r1")
     expected = (URDF
                 .replace("</commandTopic>\n    </plugin>", f"</commandTopic>\n    {NS}</plugin>")
                 .replace('libgazebo_ros_laser.so"/>', f'libgazebo_ros_laser.so">{NS}</plugin>'))
@@ -281,7 +283,7 @@ def test_inject_namespace_urdf_adds_where_missing_and_keeps_an_existing_one():
 
 
 def test_inject_namespace_urdf_replacing_existing():
-    out = api.inject_robot_namespace(URDF, "/r1", replace_existing=True)
+    out = model_xml.inject_robot_namespace(URDF, "/r1", replace_existing=True)
     assert "/fixed" not in out
     root = ET.fromstring(out.split("?>", 1)[1])
     plugins = root.findall(".//plugin")
@@ -306,66 +308,66 @@ SDF = """<sdf version="1.6">
 
 
 def test_inject_namespace_sdf():
-    out = api.inject_robot_namespace(SDF, "/r1")
+    out = model_xml.inject_robot_namespace(SDF, "/r1")
     assert out == SDF.replace('libone.so"></plugin>', f'libone.so">{NS}</plugin>')
-    replaced = api.inject_robot_namespace(SDF, "/r1", replace_existing=True)
+    replaced = model_xml.inject_robot_namespace(SDF, "/r1", replace_existing=True)
     root = ET.fromstring(replaced)
     assert [e.text for e in root.find(".//sensor/plugin").findall("robotNamespace")] == ["/r1"]
     assert [e.text for e in root.find("model/plugin").findall("robotNamespace")] == ["/r1"]
 
 
 def test_inject_namespace_empty_is_a_no_op_and_text_is_escaped():
-    assert api.inject_robot_namespace(URDF, "") is URDF
-    out = api.inject_robot_namespace(SDF, "a&b<c")
+    assert model_xml.inject_robot_namespace(URDF, "") is URDF
+    out = model_xml.inject_robot_namespace(SDF, "a&b<c")
     assert ET.fromstring(out).find("model/plugin/robotNamespace").text == "a&b<c"
 
 
 def test_inject_namespace_invalid_xml():
     with pytest.raises(ValueError, match=r"^model_xml is not valid XML: mismatched tag: line 2, column"):
-        api.inject_robot_namespace('<robot name="r">\n<plugin></robot>', "/r1")
+        model_xml.inject_robot_namespace('<robot name="r">\n<plugin></robot>', "/r1")
 
 
 # ------------------------------------------------------------------------------------------ kinds, names
 
 def test_model_xml_kind():
-    assert api.model_xml_kind(URDF) == "urdf"
-    assert api.model_xml_kind(SDF) == "sdf"
-    assert api.model_xml_kind('\n  <?xml version="1.0"?>\n<robot name="r"/>') == "urdf"
+    assert model_xml.model_xml_kind(URDF) == "urdf"
+    assert model_xml.model_xml_kind(SDF) == "sdf"
+    assert model_xml.model_xml_kind('\n  <?xml version="1.0"?>\n<robot name="r"/>') == "urdf"
 
 
 def test_model_xml_kind_errors():
     with pytest.raises(ValueError, match=r"^model_xml is not valid XML: .*line 3, column"):
-        api.model_xml_kind('\n\n<robot name="r"><link></robot>')
+        model_xml.model_xml_kind('\n\n<robot name="r"><link></robot>')
     with pytest.raises(ValueError, match=r"^model_xml is not valid XML: no element found"):
-        api.model_xml_kind("")
+        model_xml.model_xml_kind("")
     with pytest.raises(ValueError, match=r"root element <model> is neither <robot> \(URDF\) nor <sdf> \(SDF\)"):
-        api.model_xml_kind('<model name="m"/>')
+        model_xml.model_xml_kind('<model name="m"/>')
     with pytest.raises(ValueError, match="pre-SDF"):
-        api.model_xml_kind("<gazebo><model name='m'/></gazebo>")
+        model_xml.model_xml_kind("<gazebo><model name='m'/></gazebo>")
 
 
 def test_rename_urdf():
-    assert api.rename_model(URDF, "urdf", "r1") == URDF.replace('<robot name="diffbot"', '<robot name="r1"')
-    assert api.rename_model("<robot><link name='a'/></robot>", "urdf", 'x"y') == \
+    assert model_xml.rename_model(URDF, "urdf", "r1") == URDF.replace('<robot name="diffbot"', '<robot name="r1"')
+    assert model_xml.rename_model("<robot><link name='a'/></robot>", "urdf", 'x"y') == \
         "<robot name=\"x&quot;y\"><link name='a'/></robot>"
     tricky = "<robot doc='name=\"no\"' name='old'/>"
-    assert api.rename_model(tricky, "urdf", "new") == "<robot doc='name=\"no\"' name=\"new\"/>"
+    assert model_xml.rename_model(tricky, "urdf", "new") == "<robot doc='name=\"no\"' name=\"new\"/>"
 
 
 def test_rename_sdf_model_and_include():
-    assert api.rename_model(SDF, "sdf", "crate") == SDF.replace('<model name="box">', '<model name="crate">')
+    assert model_xml.rename_model(SDF, "sdf", "crate") == SDF.replace('<model name="box">', '<model name="crate">')
     include = '<sdf version="1.6"><world name="w"><include><uri>model://box</uri><name>old</name></include>' \
               '</world></sdf>'
-    assert api.rename_model(include, "sdf", "b2") == include.replace("<name>old</name>", "<name>b2</name>")
+    assert model_xml.rename_model(include, "sdf", "b2") == include.replace("<name>old</name>", "<name>b2</name>")
     bare = '<sdf version="1.6"><world name="w"><include><uri>model://box</uri></include></world></sdf>'
-    assert api.rename_model(bare, "sdf", "b2") == bare.replace("</include>", "<name>b2</name></include>")
+    assert model_xml.rename_model(bare, "sdf", "b2") == bare.replace("</include>", "<name>b2</name></include>")
 
 
 def test_rename_errors():
     with pytest.raises(ValueError, match="holds no <model>"):
-        api.rename_model('<sdf version="1.6"><light name="l"/></sdf>', "sdf", "x")
+        model_xml.rename_model('<sdf version="1.6"><light name="l"/></sdf>', "sdf", "x")
     with pytest.raises(ValueError, match="not <robot>"):
-        api.rename_model(SDF, "urdf", "x")
+        model_xml.rename_model(SDF, "urdf", "x")
 
 
 def _pose_of(model_text):
@@ -375,30 +377,30 @@ def _pose_of(model_text):
 
 def test_sdf_model_at_composes_the_file_pose_on_the_request():
     sdf = '<sdf version="1.6"><model name="m"><pose>1 0 0 0 0 0</pose><link name="l"/></model></sdf>'
-    out = api.sdf_model_at(sdf, ((0.0, 0.0, 0.5), YAW90))
+    out = model_xml.sdf_model_at(sdf, ((0.0, 0.0, 0.5), YAW90))
     assert out.startswith('<model name="m"><pose>') and out.endswith('<link name="l"/></model>')
     p, q = _pose_of(out)
     assert close(p, (0.0, 1.0, 0.5)) and same_rotation(q, YAW90)
 
 
 def test_sdf_model_at_adds_a_pose_and_reads_sdf_1_9_forms():
-    out = api.sdf_model_at('<sdf version="1.6"><model name="m"><link name="l"/></model></sdf>',
+    out = model_xml.sdf_model_at('<sdf version="1.6"><model name="m"><link name="l"/></model></sdf>',
                            ((1.0, 2.0, 3.0), (0, 0, 0, 1)))
     assert close(_pose_of(out)[0], (1.0, 2.0, 3.0))
     degrees = '<sdf version="1.9"><model name="m"><pose degrees="true">0 0 0 0 0 90</pose></model></sdf>'
-    assert same_rotation(_pose_of(api.sdf_model_at(degrees, api.IDENTITY))[1], YAW90)
+    assert same_rotation(_pose_of(model_xml.sdf_model_at(degrees, IDENTITY))[1], YAW90)
     quat = f'<sdf version="1.9"><model name="m"><pose rotation_format="quat_xyzw">0 0 0 0 0 {S} {S}</pose>' \
            f'</model></sdf>'
-    composed = _pose_of(api.sdf_model_at(quat, (api.IDENTITY[0], YAW90)))[1]
-    assert same_rotation(composed, compose((api.IDENTITY[0], YAW90), (api.IDENTITY[0], YAW90))[1])
+    composed = _pose_of(model_xml.sdf_model_at(quat, (IDENTITY[0], YAW90)))[1]
+    assert same_rotation(composed, compose((IDENTITY[0], YAW90), (IDENTITY[0], YAW90))[1])
 
 
 def test_sdf_model_at_include_and_errors():
     include = '<sdf version="1.6"><world name="w"><include><uri>model://box</uri></include></world></sdf>'
-    out = api.sdf_model_at(include, ((1.0, 0.0, 0.0), (0, 0, 0, 1)))
+    out = model_xml.sdf_model_at(include, ((1.0, 0.0, 0.0), (0, 0, 0, 1)))
     assert out.startswith("<include><uri>model://box</uri><pose>")
     with pytest.raises(ValueError, match="not 6 finite numbers"):
-        api.sdf_model_at('<sdf version="1.6"><model name="m"><pose>1 2 3</pose></model></sdf>', api.IDENTITY)
+        model_xml.sdf_model_at('<sdf version="1.6"><model name="m"><pose>1 2 3</pose></model></sdf>', IDENTITY)
 
 
 # ------------------------------------------------------------------------------------------ wrenches

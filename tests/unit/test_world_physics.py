@@ -7,7 +7,7 @@ import numpy as np
 import pybullet
 import pytest
 
-from diffbot_sim.description import meshes
+from diffbot_sim.description import mesh_formats
 from diffbot_sim.physics import World
 from diffbot_sim.world.bodies import Body, Shape, WorldDescription
 
@@ -28,7 +28,7 @@ def ring_obj(path, inner=1.0, outer=1.2, height=0.5, segments=24):
         for quad in ((ib + 0, ob + 0, ob + 1, ib + 1), (ib + 2, ib + 3, ob + 3, ob + 2),
                      (ib + 1, ob + 1, ob + 3, ib + 3), (ib + 0, ib + 2, ob + 2, ob + 0)):
             faces += [(quad[0], quad[1], quad[2]), (quad[0], quad[2], quad[3])]
-    meshes.write_obj(str(path), np.array(verts, float), np.array(faces, int))
+    mesh_formats.write_obj(str(path), np.array(verts, float), np.array(faces, int))
     return str(path)
 
 

@@ -9,10 +9,11 @@ import os
 
 import pytest
 
-from diffbot_sim.description import meshes
+from diffbot_sim.description import mesh_formats
 from diffbot_sim.errors import ModelError
 from diffbot_sim.transforms import compose, inverse, rpy_quaternion
-from diffbot_sim.world.sdf_reader import env_model_paths, read_world, ros_package_model_paths
+from diffbot_sim.world.model_paths import env_model_paths, ros_package_model_paths
+from diffbot_sim.world.sdf_reader import read_world
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ROOM = os.path.join(ROOT, "worlds", "room.world")
@@ -150,7 +151,7 @@ def test_room_world_layout_state_and_model_uri():
 
 
 def test_room_ring_mesh_is_a_hollow_hexagon():
-    vertices, faces = meshes.read_obj(os.path.join(ROOM_MODELS, "ring", "meshes", "ring.obj"))
+    vertices, faces = mesh_formats.read_obj(os.path.join(ROOM_MODELS, "ring", "meshes", "ring.obj"))
     radii = sorted({round(math.hypot(x, y), 6) for x, y, _ in vertices})
     assert radii == [0.4, 0.5] and len(faces) == 48 and vertices[:, 2].max() == 0.5
 
@@ -226,7 +227,7 @@ def test_turtlebot3_style_world(tmp_path):
     assert len(world.not_simulated) == len(set(world.not_simulated))
     assert world.warnings == []
     # the tiny .dae is a real COLLADA file our mesh reader takes (inch units honoured)
-    vertices, faces = meshes.read_dae(mesh.mesh)
+    vertices, faces = mesh_formats.read_dae(mesh.mesh)
     assert len(faces) == 4 and abs(vertices.max() - 0.254) < 1e-9
 
 

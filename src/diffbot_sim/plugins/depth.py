@@ -18,7 +18,7 @@ from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 
 from diffbot_sim.sensors import camera as cam
 from diffbot_sim.ros import messages as ros_msgs
-from diffbot_sim.plugins.camera import CameraBase
+from diffbot_sim.plugins.camera_base import CameraBase
 
 
 class DepthCamera(CameraBase):

@@ -25,9 +25,8 @@ from sensor_msgs.msg import NavSatFix
 from diffbot_sim.sensors import noise
 
 from diffbot_sim.ros import messages as ros_msgs
-from diffbot_sim.config import _bool
 from diffbot_sim.errors import ModelError, PluginNotLoaded
-from diffbot_sim.values import tag_number
+from diffbot_sim.values import check_bool, tag_number
 from diffbot_sim.plugins.base import Plugin, join
 from diffbot_sim.description.plugin_tags import read_tags
 
@@ -91,7 +90,7 @@ def settings(tags, where, root, generator, notes=None):
         "period": period,
         "position": noise.hector_models(tags, "", generator, where),
         "velocity": noise.hector_models(tags, "velocity", generator, where),
-        "world_coordinates": _bool(f"<useWorldSphericalCoordinates> of {where}",
+        "world_coordinates": check_bool(f"<useWorldSphericalCoordinates> of {where}",
                                    tags.get("useWorldSphericalCoordinates", "false")),
     }
     return out

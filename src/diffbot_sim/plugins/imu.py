@@ -39,11 +39,10 @@ from sensor_msgs.msg import Imu
 from diffbot_sim.sensors import noise
 
 from diffbot_sim.ros import messages as ros_msgs
-from diffbot_sim.config import _bool
 from diffbot_sim.errors import ModelError, PluginNotLoaded
 from diffbot_sim.description.plugin_tags import read_tags, vector
 from diffbot_sim.description.urdf_model import tag_value
-from diffbot_sim.values import tag_number
+from diffbot_sim.values import check_bool, tag_number
 from diffbot_sim.transforms import qconj, qmul, qnormalize, rpy_quaternion
 from diffbot_sim.plugins.base import Plugin, join
 
@@ -169,7 +168,7 @@ def sensor_settings(sensor, plugin, seed, where, notes=None):
                     if src.strip().lstrip("~/") == "out" and dst.strip():
                         s.topic = dst.strip()
         s.frame = tags.get("frame_name") or sensor.link
-        s.initial_reference = _bool(f"<initial_orientation_as_reference> of {where}",
+        s.initial_reference = check_bool(f"<initial_orientation_as_reference> of {where}",
                                     tags.get("initial_orientation_as_reference", "false"))
         s.period = 1.0 / sdf_rate if sdf_rate > 0 else 0.0
         s.lazy = False
@@ -197,7 +196,7 @@ def sensor_settings(sensor, plugin, seed, where, notes=None):
             s.rpy_offset = vector(tags["rpyOffset"], where, "rpyOffset")
         if "xyzOffset" in tags:
             s.xyz_offset = vector(tags["xyzOffset"], where, "xyzOffset")
-        s.initial_reference = _bool(f"<initialOrientationAsReference> of {where}",
+        s.initial_reference = check_bool(f"<initialOrientationAsReference> of {where}",
                                     tags.get("initialOrientationAsReference", "false"))
         s.covariance = (s.gaussian_noise ** 2,) * 3
         known = {"topicName", "frameName", "updateRateHZ", "gaussianNoise", "rpyOffset", "xyzOffset",

@@ -24,11 +24,10 @@ from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import Empty
 
 from diffbot_sim.ros import messages as ros_msgs
-from diffbot_sim.config import _bool, _string
 from diffbot_sim.errors import ModelError
 from diffbot_sim.control.kinematics import quaternion_from_yaw, wheel_speeds
 from diffbot_sim.description.urdf_model import tag_value
-from diffbot_sim.values import tag_number
+from diffbot_sim.values import check_bool, check_string, tag_number
 from diffbot_sim.plugins.base import Plugin, finite_twist, join
 from diffbot_sim.plugins.joint_motors import UNLIMITED_EFFORT
 
@@ -186,8 +185,8 @@ def create(ctx, element, path, params):
                          ctx.model.source, path)
     notes = ctx.warnings
     values = {
-        "left_wheel_joint_name": _string(f"<left_wheel_joint_name> of {path}", tags["left_wheel_joint_name"]),
-        "right_wheel_joint_name": _string(f"<right_wheel_joint_name> of {path}", tags["right_wheel_joint_name"]),
+        "left_wheel_joint_name": check_string(f"<left_wheel_joint_name> of {path}", tags["left_wheel_joint_name"]),
+        "right_wheel_joint_name": check_string(f"<right_wheel_joint_name> of {path}", tags["right_wheel_joint_name"]),
         "wheel_separation": tag_number(f"<wheel_separation> of {path}", tags["wheel_separation"], notes,
                                        low=0.0, low_open=True),
         "wheel_diameter": tag_number(f"<wheel_diameter> of {path}", tags["wheel_diameter"], notes, low=0.0,
@@ -195,7 +194,7 @@ def create(ctx, element, path, params):
         "torque": tag_number(f"<torque> of {path}", tags["torque"], notes, low=0.0),
         "velocity_command_timeout": tag_number(f"<velocity_command_timeout> of {path}",
                                                tags["velocity_command_timeout"], notes, low=0.0),
-        "publish_tf": _bool(f"<publish_tf> of {path}", tags.get("publish_tf", "false")),
+        "publish_tf": check_bool(f"<publish_tf> of {path}", tags.get("publish_tf", "false")),
         "update_rate": tag_number(f"<update_rate> of {path}", tags.get("update_rate", 50.0), notes, low=0.0),
     }
     unknown = sorted(set(tags) - set(REQUIRED) - set(ACCEPTED))

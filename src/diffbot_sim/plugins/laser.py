@@ -25,10 +25,9 @@ from sensor_msgs.msg import LaserScan, PointCloud, PointCloud2, Range
 from diffbot_sim.sensors import ray as ray_sensor
 
 from diffbot_sim.ros import messages as ros_msgs
-from diffbot_sim.config import _string
 from diffbot_sim.errors import ConfigError
 from diffbot_sim.description.urdf_model import tag_value
-from diffbot_sim.values import tag_number
+from diffbot_sim.values import check_string, tag_number
 from diffbot_sim.plugins.base import Plugin, join
 
 ROS1_LASERS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so")
@@ -51,7 +50,7 @@ def ros1_frame(ctx, values, sensor, path, warn=True):
     """The frame a ROS 1 ray plugin publishes in: ``frameName``, else the sensor's link (gazebo_ros says
     ``/world``: with a warning when ``warn``), without a leading slash, with the robot's tf_prefix."""
     if "frameName" in values:
-        frame = _string(f"<frameName> of {path}", values["frameName"])
+        frame = check_string(f"<frameName> of {path}", values["frameName"])
     else:
         frame = sensor.link or "world"
         if warn:
@@ -185,7 +184,7 @@ def _ros1(ctx, sensor, element, path, filename):
                             f"frameName (rate and noise come from the <sensor>): {', '.join(ignored)}")
     ns = ros1_namespace(ctx, values)
     if "topicName" in values:
-        topic = _string(f"<topicName> of {path}", values["topicName"])
+        topic = check_string(f"<topicName> of {path}", values["topicName"])
     else:
         topic = "/world"
         ctx.warnings.append(f"{path}: no <topicName>: publishing on /world, {filename}'s default")

@@ -12,9 +12,8 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
 from diffbot_sim.ros import messages as ros_msgs
-from diffbot_sim.config import _bool, _string
 from diffbot_sim.description.urdf_model import tag_value
-from diffbot_sim.values import tag_number
+from diffbot_sim.values import check_bool, check_string, tag_number
 from diffbot_sim.plugins.base import Plugin, finite_twist, join
 
 DEFAULTS = {"commandTopic": "cmd_vel", "odometryTopic": "odom", "odometryFrame": "odom",
@@ -105,9 +104,9 @@ def create(ctx, element, path, params):
         elif child.tag == "cmdTimeout":
             values[child.tag] = tag_number(label, text, ctx.warnings)
         elif child.tag == "publishOdometryTf":
-            values[child.tag] = _bool(label, text)
+            values[child.tag] = check_bool(label, text)
         elif child.tag in DEFAULTS:
-            values[child.tag] = _string(label, text, allow_empty=child.tag == "robotNamespace")
+            values[child.tag] = check_string(label, text, allow_empty=child.tag == "robotNamespace")
         elif child.tag not in ("alwaysOn", "updateRate", "rosDebugLevel"):
             unknown.append(child.tag)
     if unknown:

@@ -16,8 +16,7 @@ from sensor_msgs.msg import Range as RangeMsg
 from diffbot_sim.sensors import ray as ray_sensor
 
 from diffbot_sim.ros import messages as ros_msgs
-from diffbot_sim.config import _string
-from diffbot_sim.values import tag_number
+from diffbot_sim.values import check_string, tag_number
 from diffbot_sim.plugins.base import join
 from diffbot_sim.plugins.laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
 
@@ -60,7 +59,7 @@ def create(ctx, sensor, element, params):
     if ignored:
         ctx.warnings.append(f"{path}: tags ignored (gazebo_ros_range does not read them): {', '.join(ignored)}")
     ns = ros1_namespace(ctx, values)
-    topic = _string(f"<topicName> of {path}", values["topicName"]) if "topicName" in values else "/range"
+    topic = check_string(f"<topicName> of {path}", values["topicName"]) if "topicName" in values else "/range"
     frame = ros1_frame(ctx, values, sensor, path)
     ultrasound = values.get("radiation", "ultrasound").strip() == "ultrasound"
     fov = tag_number(f"<fov> of {path}", values["fov"], ctx.warnings, low=0.0) if "fov" in values else 0.05

@@ -16,8 +16,7 @@ sensor_msgs/PointCloud2 with x, y, z, intensity, ring, time). Casting and range 
 import numpy as np
 
 from diffbot_sim.ros import messages as ros_msgs
-from diffbot_sim.config import _bool
-from diffbot_sim.values import tag_number
+from diffbot_sim.values import check_bool, tag_number
 from diffbot_sim.plugins.base import join
 from diffbot_sim.plugins.laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
 from sensor_msgs.msg import PointCloud, PointCloud2
@@ -80,7 +79,7 @@ class VelodyneLaser(RaySensorPlugin):
         self.max_range = tag_number(label("max_range"), values.get("max_range", 130.0), notes, low=0.0,
                                     low_open=True)
         self.noise = tag_number(label("gaussianNoise"), values.get("gaussianNoise", 0.0), notes, low=0.0)
-        self.organize = _bool(label("organize_cloud"), values.get("organize_cloud", "false"))
+        self.organize = check_bool(label("organize_cloud"), values.get("organize_cloud", "false"))
         self.min_intensity = tag_number(label("min_intensity"), values.get("min_intensity", 0.0), notes)
         self.pub = ctx.publisher(join(ns, values.get("topicName") or "/velodyne_points"), PointCloud2)
         self.builder = ros_msgs.RingCloudBuilder(self.frame)

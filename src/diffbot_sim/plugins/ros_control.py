@@ -39,11 +39,10 @@ from diffbot_sim.control import diff_drive_controller as ddc
 from diffbot_sim.ros import messages as ros_msgs
 
 from diffbot_sim.control import controller_switching as switching
-from diffbot_sim.config import _number, _string
 from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.control.kinematics import quaternion_from_yaw
 from diffbot_sim.description.urdf_model import tag_value
-from diffbot_sim.values import tag_number
+from diffbot_sim.values import check_number, check_string, tag_number
 from diffbot_sim.plugins.base import Plugin, get_param, join, next_due
 from diffbot_sim.plugins.joint_motors import effort_limit
 
@@ -384,7 +383,7 @@ class JointStateControllerRunner:
         if rate is None:
             ctx.warnings.append(f"{name}: no publish_rate (JointStateController requires one); using 50 Hz")
             rate = 50.0
-        rate = _number(f"{name}/publish_rate", rate, low=0.0, low_open=True)
+        rate = check_number(f"{name}/publish_rate", rate, low=0.0, low_open=True)
         self.period = 1.0 / rate
         self.joints_ = [j for j in hw.interfaces if j in hw.index]
         self.extra = []
@@ -435,7 +434,7 @@ class JointCommandRunner:
     def __init__(self, ctx, hw, name, params, manager_ns, interface):
         self.ctx, self.hw, self.name = ctx, hw, name
         self.type = params.get("type")
-        self.joint = _string(f"{name}/joint", params.get("joint"))
+        self.joint = check_string(f"{name}/joint", params.get("joint"))
         ctx.model.joint(self.joint, name)
         if hw.interfaces.get(self.joint) != interface:
             raise ModelError(f"controller {name} needs joint '{self.joint}' with a {interface} transmission",

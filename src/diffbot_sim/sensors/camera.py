@@ -21,10 +21,9 @@ from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
-from diffbot_sim.config import _number
 from diffbot_sim.errors import ConfigError
 from diffbot_sim.description.urdf_model import tag_value
-from diffbot_sim.values import tag_number
+from diffbot_sim.values import check_number, tag_number
 
 CAMERA_TYPES = ("camera", "depth")
 #: ``<image><format>`` -> ROS encoding (GazeboRosCameraUtils). Rendered here: these three.
@@ -80,7 +79,7 @@ def parse_sensor(element, path, name=None):
         parts = pose.text.split()
         if len(parts) != 6:
             raise ConfigError(f"<pose> of {path}", pose.text, "six numbers: x y z roll pitch yaw")
-        values = [_number(f"<pose> of {path}", p) for p in parts]
+        values = [check_number(f"<pose> of {path}", p) for p in parts]
         cfg.pose = (tuple(values[:3]), tuple(values[3:]))
     camera = element.find("camera")
     if camera is None:
@@ -331,7 +330,7 @@ def read_plugin(element, path):
             continue
         text = tag_value(child)
         if key in NUMERIC:
-            tags.values[key] = _number(f"<{child.tag}> of {path}", text) if text else 0.0
+            tags.values[key] = check_number(f"<{child.tag}> of {path}", text) if text else 0.0
         elif key == "depth16":
             tags.values[key] = text.lower() in ("true", "1")
         else:

@@ -22,9 +22,8 @@ from typing import List, Tuple
 
 import numpy as np
 
-from diffbot_sim.config import _bool, _number
 from diffbot_sim.errors import ConfigError
-from diffbot_sim.values import tag_number
+from diffbot_sim.values import check_bool, check_number, tag_number
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.transforms import rpy_matrix
 
@@ -133,7 +132,7 @@ def _pose(text, where):
     parts = text.split()
     if len(parts) != 6:
         raise ConfigError(f"<pose> of {where}", text, "six numbers: x y z roll pitch yaw")
-    values = [_number(f"<pose> of {where}", p) for p in parts]
+    values = [check_number(f"<pose> of {where}", p) for p in parts]
     return tuple(values[:3]), tuple(values[3:])
 
 
@@ -163,7 +162,7 @@ def parse_sensor(element, path, name=None):
     for tag in ("always_on", "visualize"):
         el = element.find(tag)
         if el is not None:
-            setattr(cfg, tag, _bool(f"<{tag}> of {path}", tag_value(el)))
+            setattr(cfg, tag, check_bool(f"<{tag}> of {path}", tag_value(el)))
     pose = element.find("pose")
     if pose is not None and (pose.text or "").strip():
         cfg.pose = _pose(pose.text, path)

@@ -25,7 +25,7 @@ from std_srvs.srv import Empty
 
 from diffbot_sim.description import meshes
 
-from diffbot_sim.gazebo import world_api
+from diffbot_sim.gazebo import model_xml, world_api
 from diffbot_sim.description.model_files import package_path
 from diffbot_sim.errors import DiffbotSimError
 from diffbot_sim.plugins.base import close_handle, publisher
@@ -301,31 +301,32 @@ class GazeboApi:
             raise RequestError(f"SpawnModel: model_name '{name}' is not a valid model name")
         if name in self.models():
             raise RequestError(f"SpawnModel: Failure - entity '{name}' already exists.")
-        kind = world_api.model_xml_kind(req.model_xml)
+        kind = model_xml.model_xml_kind(req.model_xml)
         pose = world_api.check_pose(_pose_tuple(req.initial_pose), "initial_pose")
         frame = self._frame_motion(req.reference_frame, "reference_frame")
         if frame is not None:
             pose = compose(frame[0], pose)
         namespace = req.robot_namespace
         if kind == "urdf":
-            text = world_api.prepare_urdf(req.model_xml, package_path)
-            text = world_api.inject_robot_namespace(text, namespace)
-            text = world_api.rename_model(text, "urdf", name)
+            text = model_xml.prepare_urdf(req.model_xml, package_path)
+            text = model_xml.inject_robot_namespace(text, namespace)
+            text = model_xml.rename_model(text, "urdf", name)
             runtime = self.spawn_urdf(name, text, f"{self.ns}/spawn_{service_kind}_model({name})", pose)
             return f"SpawnModel: Successfully spawned entity '{runtime.name}'"
-        text = world_api.inject_robot_namespace(req.model_xml, namespace)
-        text = world_api.rename_model(text, "sdf", name)
+        text = model_xml.inject_robot_namespace(req.model_xml, namespace)
+        text = model_xml.rename_model(text, "sdf", name)
         count = self._spawn_sdf(name, text, pose)
         return f"SpawnModel: Successfully spawned entity '{name}' ({count} bodies)"
 
     def _spawn_sdf(self, name, text, pose):
         """An SDF model becomes world bodies: the model's pose replaced by the request's, as Gazebo does."""
-        from diffbot_sim.world.sdf_reader import read_world, ros_package_model_paths
-        model_xml = world_api.sdf_model_at(text, pose)
+        from diffbot_sim.world.model_paths import ros_package_model_paths
+        from diffbot_sim.world.sdf_reader import read_world
+        placed = model_xml.sdf_model_at(text, pose)
         with tempfile.TemporaryDirectory(prefix="spawn_sdf_") as tmp:
             path = os.path.join(tmp, f"{name}.world")
             with open(path, "w") as out:
-                out.write(f'<sdf version="1.7"><world name="spawn">{model_xml}</world></sdf>')
+                out.write(f'<sdf version="1.7"><world name="spawn">{placed}</world></sdf>')
             world = read_world(path, package_model_paths=ros_package_model_paths())
         for text in world.warnings + [f"not simulated: {'; '.join(world.not_simulated)}"] * bool(world.not_simulated):
             rospy.logwarn(f"spawned model {name}: {text}")

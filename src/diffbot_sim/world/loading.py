@@ -6,7 +6,8 @@ import os
 from diffbot_sim.description.model_files import package_path
 from diffbot_sim.errors import ModelError
 from diffbot_sim.world.map_image import read_map
-from diffbot_sim.world.sdf_reader import read_world, ros_package_model_paths
+from diffbot_sim.world.model_paths import ros_package_model_paths
+from diffbot_sim.world.sdf_reader import read_world
 
 
 def resolve_world_path(name, package_root=None):

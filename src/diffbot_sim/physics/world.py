@@ -1,9 +1,5 @@
-"""The only module that talks to PyBullet.
-
-One ``World`` owns one physics client (its own, never the module-global one, so tests can run several
-worlds side by side) and is used from one thread. Robots are loaded from URDF text; everything returned is
-plain numbers, in URDF link frames (not PyBullet's centre-of-mass frames).
-"""
+"""One PyBullet world: the ground, the world's bodies, the robots placed and set down in it, rays and camera
+images cast into it, stepped only by ``step()``."""
 import contextlib
 import math
 import os
@@ -11,13 +7,9 @@ import tempfile
 
 from diffbot_sim.description import lumping
 from diffbot_sim.errors import ModelError
+from diffbot_sim.physics.client import egl_probe, pybullet, pybullet_data, quiet
+from diffbot_sim.physics.robot import Robot, point_velocity
 
-#: Gazebo's friction coefficient for a surface that gives none (SDF <surface><friction><ode><mu> default).
-GAZEBO_DEFAULT_MU = 1.0
-#: Gazebo's contact stiffness [N/m] and damping [N·s/m] defaults (SDF <ode><kp>/<kd>), used to complete a
-#: link that gives only one of the two.
-GAZEBO_DEFAULT_KP = 1e12
-GAZEBO_DEFAULT_KD = 1.0
 #: How fast [1/s] Bullet may push a robot being set down out of what it lands on: a penetration ``d`` is undone
 #: at most at ``LANDING_CORRECTION_RATE * d`` m/s (the contact ERP is this times the step). Gazebo caps each
 #: body's correcting velocity at its SDF ``<max_vel>`` (0.01 m/s by default), so what lands on a contact lands
@@ -38,54 +30,6 @@ DEPENETRATION_PASSES = 4
 #: Linux); at exactly 16384 it returns 16383 results for list input and none for numpy input (bullet3 #4215,
 #: measured here: sensors.md section 6.1), and above it raises. 16383 works both ways.
 RAY_BATCH_LIMIT = 16383
-
-
-@contextlib.contextmanager
-def _quiet(fd):
-    """Silence a file descriptor: PyBullet's C code prints a build banner on import (stderr) and
-    link-merging chatter while loading (stdout), which would break the one-line error contract."""
-    try:
-        saved = os.dup(fd)
-    except OSError:
-        yield
-        return
-    try:
-        with open(os.devnull, "w") as null:
-            os.dup2(null.fileno(), fd)
-        yield
-    finally:
-        os.dup2(saved, fd)
-        os.close(saved)
-
-
-with _quiet(1), _quiet(2):
-    import pybullet
-    import pybullet_data
-
-
-#: Probe program: load PyBullet's EGL plugin in a throw-away process. On a machine without an EGL library
-#: the plugin ends the whole process (status 1, no exception), so it must never be tried in ours first.
-_EGL_PROBE = ("import sys, pybullet as p\n"
-              "c = p.connect(p.DIRECT)\n"
-              "sys.exit(0 if p.loadPlugin(sys.argv[1], '_eglRendererPlugin', physicsClientId=c) >= 0 else 3)\n")
-
-
-def egl_probe(plugin_path, timeout=30.0):
-    """None when PyBullet's EGL plugin loads in a child process, else why not (one line)."""
-    import subprocess
-    import sys
-
-    try:
-        proc = subprocess.run([sys.executable, "-c", _EGL_PROBE, plugin_path], stdin=subprocess.DEVNULL,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, timeout=timeout)
-    except (OSError, subprocess.TimeoutExpired) as err:
-        return f"the EGL probe did not finish ({err})"
-    if proc.returncode == 3:
-        return "PyBullet's EGL plugin did not load"
-    if proc.returncode != 0:
-        return (f"PyBullet's EGL plugin ended its process (status {proc.returncode}): no usable EGL/OpenGL "
-                "library on this machine")
-    return None
 
 
 class World:
@@ -137,7 +81,7 @@ class World:
         flags = pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_USE_IMPLICIT_CYLINDER
         if orientation is None:
             orientation = pybullet.getQuaternionFromEuler((0.0, 0.0, yaw))
-        with _quiet(1):
+        with quiet(1):
             body = pybullet.loadURDF(path, position, orientation, flags=flags, physicsClientId=self.client)
         if body < 0:
             raise ModelError("PyBullet could not load the model", model.source)
@@ -383,7 +327,7 @@ class World:
         problem = egl_probe(loader.get_filename())
         if problem is not None:
             return problem
-        with _quiet(1), _quiet(2):
+        with quiet(1), quiet(2):
             plugin = pybullet.loadPlugin(loader.get_filename(), "_eglRendererPlugin", physicsClientId=self.client)
         if plugin < 0:
             return "pybullet could not load its EGL plugin (no EGL/OpenGL library?)"
@@ -414,7 +358,7 @@ class World:
         com, _ = pybullet.getBasePositionAndOrientation(uid, physicsClientId=self.client)
         linear, angular = pybullet.getBaseVelocity(uid, physicsClientId=self.client)
         pose = self.body_pose(uid, inertial_pose)
-        v = _point_velocity(linear, angular, [pose[0][i] - com[i] for i in range(3)])
+        v = point_velocity(linear, angular, [pose[0][i] - com[i] for i in range(3)])
         return (tuple(pose[0]), tuple(pose[1])), v, tuple(angular)
 
     def set_body_motion(self, uid, inertial_pose, pose, linear, angular):
@@ -422,7 +366,7 @@ class World:
         axes); a static body only moves."""
         self._place(uid, pose, inertial_pose)
         com, _ = pybullet.getBasePositionAndOrientation(uid, physicsClientId=self.client)
-        v = _point_velocity(linear, angular, [com[i] - pose[0][i] for i in range(3)])
+        v = point_velocity(linear, angular, [com[i] - pose[0][i] for i in range(3)])
         pybullet.resetBaseVelocity(uid, v, angular, physicsClientId=self.client)
 
     def apply_wrench(self, uid, link, force, torque, point=None):
@@ -462,266 +406,3 @@ class World:
             with contextlib.suppress(OSError):
                 os.remove(path)
         self._files = []
-
-
-def contact_damping(kp, kd, time_step, max_erp):
-    """The damping [N·s/m] to give Bullet for a Gazebo contact of stiffness ``kp`` [N/m] and damping ``kd``.
-
-    Bullet (like ODE) turns them into ERP = dt·kp / (dt·kp + kd) and CFM = 1 / (dt·kp + kd): the stiffness is
-    kept whatever the damping, while the ERP, how much of a penetration is undone per step, grows to ~1 for
-    the stiff, lightly damped contacts real models give (kp 1e7, kd 1). Gazebo caps that correction at
-    ``<max_vel>``; Bullet cannot, so the damping is raised until the ERP is at most ``max_erp``: the same
-    spring, damped enough not to throw what lands on it (see LANDING_CORRECTION_RATE).
-    """
-    stiff = time_step * kp
-    return max(kd, 0.0, stiff * (1.0 / max_erp - 1.0)) if max_erp < 1.0 else max(kd, 0.0)
-
-
-def _point_velocity(linear, angular, r):
-    """Velocity of a point ``r`` away from where ``linear`` is measured on a rigid body turning at
-    ``angular``: v + w x r (all world axes)."""
-    return (linear[0] + angular[1] * r[2] - angular[2] * r[1],
-            linear[1] + angular[2] * r[0] - angular[0] * r[2],
-            linear[2] + angular[0] * r[1] - angular[1] * r[0])
-
-
-def _into_frame(orientation, *vectors):
-    """World-axes ``vectors`` expressed in the axes of a frame with world ``orientation`` (x, y, z, w)."""
-    _, inverse = pybullet.invertTransform((0, 0, 0), orientation)
-    return tuple(tuple(pybullet.multiplyTransforms((0, 0, 0), inverse, v, (0, 0, 0, 1))[0]) for v in vectors)
-
-
-class Robot:
-    """One loaded robot body: joint lookup, motors, state read-out. Created by ``World.load_robot``."""
-
-    def __init__(self, client, body, model, position, orientation, frames=None, time_step=1 / 240, landing_erp=1.0):
-        self.client = client
-        self.time_step, self.landing_erp = time_step, landing_erp
-        self.frames = dict(frames or {})  # URDF link -> (PyBullet link carrying it, xyz, quaternion)
-        self.gravity = -9.81  # set by World.load_robot
-        self.body = body
-        self.model = model
-        self.spawn = (tuple(position), tuple(orientation))
-        self.joint_index = {}
-        for index in range(pybullet.getNumJoints(body, physicsClientId=client)):
-            info = pybullet.getJointInfo(body, index, physicsClientId=client)
-            if info[2] != pybullet.JOINT_FIXED:
-                self.joint_index[info[1].decode()] = index
-        # Root link frame relative to PyBullet's base (centre-of-mass) frame.
-        dyn = pybullet.getDynamicsInfo(body, -1, physicsClientId=client)
-        self._inertial_inv = pybullet.invertTransform(dyn[3], dyn[4])
-        self._link_index = {pybullet.getBodyInfo(body, physicsClientId=client)[0].decode(): -1}
-        for index in range(pybullet.getNumJoints(body, physicsClientId=client)):
-            info = pybullet.getJointInfo(body, index, physicsClientId=client)
-            self._link_index[info[12].decode()] = index
-        self._apply_surfaces()
-        self.free_joints(list(self.joint_index.values()))
-
-    def _apply_surfaces(self):
-        """Each PyBullet link gets the Gazebo surface of the URDF link it is (lumping only merged links of
-        equal surface): friction from mu1/mu2 (PyBullet has one coefficient per link: the lower one),
-        Gazebo's default 1.0 when none is given; kp/kd as contact stiffness/damping (:meth:`damp_contacts`)."""
-        self._contacts = {}  # PyBullet link index -> (kp, kd) of the links that give them
-        for link, index in self._link_index.items():
-            surface = self.model.surface(link)
-            mus = [surface[k] for k in ("mu1", "mu2") if k in surface]
-            pybullet.changeDynamics(self.body, index, lateralFriction=min(mus) if mus else GAZEBO_DEFAULT_MU,
-                                    physicsClientId=self.client)
-            if "kp" in surface or "kd" in surface:
-                kp = surface.get("kp", GAZEBO_DEFAULT_KP)
-                if kp > 0:
-                    self._contacts[index] = (kp, max(surface.get("kd", GAZEBO_DEFAULT_KD), 0.0))
-        self.damp_contacts(False)
-
-    def damp_contacts(self, landing):
-        """The links' kp/kd as contact stiffness/damping: as the model gives them, or (``landing``) with the
-        damping raised so that the contact ERP stays within ``landing_erp`` (:func:`contact_damping`): the
-        same springs, damped enough not to throw a robot being set down."""
-        for index, (kp, kd) in self._contacts.items():
-            damping = contact_damping(kp, kd, self.time_step, self.landing_erp) if landing else kd
-            pybullet.changeDynamics(self.body, index, contactStiffness=kp, contactDamping=damping,
-                                    physicsClientId=self.client)
-
-    def laser_retro(self):
-        """{(body, PyBullet link index): laserRetro} of links whose ``<gazebo reference>`` gives one. A
-        PyBullet link carrying lumped links takes its own value, else the first lumped link's (PyBullet does
-        not say which shape of a link a ray hit)."""
-        table = {}
-        frames = self.frames or {name: (name, None, None) for name in self._link_index}
-        for link, (carrier, _, _) in sorted(frames.items(), key=lambda item: item[0] != item[1][0]):
-            value = self.model.surface(link).get("laserRetro")
-            key = (self.body, self._link_index.get(carrier, -1))
-            if value and key not in table:
-                table[key] = float(value)
-        return table
-
-    def link_pose(self, name):
-        """World pose ((x, y, z), (qx, qy, qz, qw)) of URDF link ``name``'s frame, lumped or not.
-
-        Raises:
-            KeyError: the model has no such link.
-        """
-        carrier, xyz, quat = self.frames[name] if self.frames else (name, (0, 0, 0), (0, 0, 0, 1))
-        index = self._link_index[carrier]
-        if index == -1:
-            base = self.base_pose()
-        else:
-            state = pybullet.getLinkState(self.body, index, physicsClientId=self.client)
-            base = (state[4], state[5])
-        return pybullet.multiplyTransforms(base[0], base[1], xyz, quat)
-
-    def position_in_base(self, name):
-        """Where URDF link ``name``'s frame is in the root link's frame: (x, y, z) [m]."""
-        base = pybullet.invertTransform(*self.base_pose())
-        return tuple(pybullet.multiplyTransforms(*base, self.link_pose(name)[0], (0, 0, 0, 1))[0])
-
-    def indices(self, names):
-        return [self.joint_index[name] for name in names]
-
-    def total_mass(self):
-        """Mass [kg] PyBullet simulates, over every link (merged fixed links included)."""
-        count = pybullet.getNumJoints(self.body, physicsClientId=self.client)
-        return sum(pybullet.getDynamicsInfo(self.body, i, physicsClientId=self.client)[0]
-                   for i in range(-1, count))
-
-    def smallest_inertia(self, index):
-        """The smallest principal moment [kg·m^2] of joint ``index``'s child link (a bound on its inertia
-        about the joint axis, for stability checks)."""
-        return min(pybullet.getDynamicsInfo(self.body, index, physicsClientId=self.client)[2])
-
-    def free_joints(self, indices):
-        """Passive joints: PyBullet's default velocity motor would brake them; force 0 lets them roll."""
-        if indices:
-            pybullet.setJointMotorControlArray(self.body, indices, pybullet.VELOCITY_CONTROL,
-                                               targetVelocities=[0.0] * len(indices), forces=[0.0] * len(indices),
-                                               physicsClientId=self.client)
-
-    def set_velocities(self, indices, velocities, max_forces):
-        """Velocity motors: drive each joint towards its target [rad/s] with at most ``max_forces`` [N·m]."""
-        pybullet.setJointMotorControlArray(self.body, indices, pybullet.VELOCITY_CONTROL,
-                                           targetVelocities=velocities, forces=max_forces,
-                                           physicsClientId=self.client)
-
-    def set_positions(self, indices, positions, max_forces):
-        pybullet.setJointMotorControlArray(self.body, indices, pybullet.POSITION_CONTROL,
-                                           targetPositions=positions, forces=max_forces,
-                                           physicsClientId=self.client)
-
-    def set_efforts(self, indices, efforts):
-        """Torque control; PyBullet needs the joint's velocity motor off first (``free_joints``)."""
-        pybullet.setJointMotorControlArray(self.body, indices, pybullet.TORQUE_CONTROL, forces=efforts,
-                                           physicsClientId=self.client)
-
-    def joint_states(self, indices):
-        """(positions [rad], velocities [rad/s], efforts [N·m]) of the given joints, in one call."""
-        states = pybullet.getJointStates(self.body, indices, physicsClientId=self.client)
-        return [s[0] for s in states], [s[1] for s in states], [s[3] for s in states]
-
-    def base_pose(self):
-        """Root link frame in the world: ((x, y, z), (qx, qy, qz, qw))."""
-        com_pos, com_orn = pybullet.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
-        return pybullet.multiplyTransforms(com_pos, com_orn, *self._inertial_inv)
-
-    def base_twist(self, pose=None):
-        """Root link frame velocity, in that frame: ((vx, vy, vz) [m/s], (wx, wy, wz) [rad/s])."""
-        com_pos, _ = pybullet.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
-        linear, angular = pybullet.getBaseVelocity(self.body, physicsClientId=self.client)
-        position, orientation = pose or self.base_pose()
-        # Velocity of the link origin, not of the centre of mass.
-        v = _point_velocity(linear, angular, [position[i] - com_pos[i] for i in range(3)])
-        return _into_frame(orientation, v, angular)
-
-    def link_motion(self, name):
-        """URDF link ``name``'s frame (lumped or not) in the world: (pose ((x, y, z), (qx, qy, qz, qw)),
-        linear velocity of the frame's origin (v + w x r from the carrier's centre of mass) [m/s], angular
-        velocity [rad/s]), both velocities in world axes. A lumped link moves with its carrier.
-
-        Raises:
-            KeyError: the model has no such link.
-        """
-        carrier, xyz, quat = self.frames[name] if self.frames else (name, (0, 0, 0), (0, 0, 0, 1))
-        index = self._link_index[carrier]
-        c = self.client
-        if index == -1:
-            com, _ = pybullet.getBasePositionAndOrientation(self.body, physicsClientId=c)
-            linear, angular = pybullet.getBaseVelocity(self.body, physicsClientId=c)
-            frame = self.base_pose()
-        else:
-            state = pybullet.getLinkState(self.body, index, computeLinkVelocity=1, computeForwardKinematics=1,
-                                          physicsClientId=c)
-            com, frame, linear, angular = state[0], (state[4], state[5]), state[6], state[7]
-        pose = pybullet.multiplyTransforms(frame[0], frame[1], xyz, quat)
-        v = _point_velocity(linear, angular, [pose[0][i] - com[i] for i in range(3)])
-        return (tuple(pose[0]), tuple(pose[1])), v, tuple(angular)
-
-    def link_twist(self, name):
-        """(pose, linear velocity [m/s], angular velocity [rad/s]) of URDF link ``name``'s frame, the
-        velocities in that frame's own axes (as ``base_twist`` for the root)."""
-        pose, linear, angular = self.link_motion(name)
-        local_v, local_w = _into_frame(pose[1], linear, angular)
-        return pose, local_v, local_w
-
-    def link_imu(self, name, previous_velocity, dt, offset=None):
-        """What an IMU on URDF link ``name`` (lumped or not) reads, in the link's frame (or in the frame at
-        ``offset`` = ((x, y, z), (qx, qy, qz, qw)) in the link's, an SDF sensor ``<pose>``): (pose, angular
-        velocity [rad/s], proper acceleration [m/s^2], world velocity of the frame origin). The acceleration
-        is the finite difference of the origin's world velocity since ``previous_velocity`` (the value this
-        call returned ``dt`` seconds ago; None or dt <= 0: taken as unchanged) minus gravity, so it reads
-        +9.81 on an upward z at rest (REP 145). The caller keeps the velocity: no state here."""
-        pose, linear, angular = self.link_motion(name)
-        if offset is not None:
-            moved = pybullet.multiplyTransforms(pose[0], pose[1], offset[0], offset[1])
-            linear = _point_velocity(linear, angular, [moved[0][i] - pose[0][i] for i in range(3)])
-            pose = (tuple(moved[0]), tuple(moved[1]))
-        if previous_velocity is None or dt <= 0:
-            accel = [0.0, 0.0, 0.0]
-        else:
-            accel = [(linear[i] - previous_velocity[i]) / dt for i in range(3)]
-        accel[2] -= self.gravity
-        local_w, local_a = _into_frame(pose[1], angular, accel)
-        return pose, local_w, local_a, linear
-
-    def set_planar_velocity(self, vx, vy, wz):
-        """Holonomic body velocity (gazebo_ros_planar_move): ``vx, vy`` [m/s] in the base frame's heading,
-        ``wz`` [rad/s] about the world z. The vertical velocity is left to gravity and contacts."""
-        linear, _ = pybullet.getBaseVelocity(self.body, physicsClientId=self.client)
-        _, orientation = self.base_pose()
-        yaw = pybullet.getEulerFromQuaternion(orientation)[2]
-        c, s = math.cos(yaw), math.sin(yaw)
-        pybullet.resetBaseVelocity(self.body, (c * vx - s * vy, s * vx + c * vy, linear[2]), (0.0, 0.0, wz),
-                                   physicsClientId=self.client)
-
-    def link_carrier(self, name):
-        """PyBullet link index carrying URDF link ``name`` (lumped links: their carrier). KeyError if none."""
-        carrier = self.frames[name][0] if self.frames else name
-        return self._link_index[carrier]
-
-    def set_base_motion(self, pose, linear, angular):
-        """Teleport the root link frame to ``pose`` with the given velocity of its origin [m/s] and angular
-        velocity [rad/s], world axes (set_model_state); joints keep their angles."""
-        com = pybullet.multiplyTransforms(pose[0], pose[1], *pybullet.invertTransform(*self._inertial_inv))
-        pybullet.resetBasePositionAndOrientation(self.body, com[0], com[1], physicsClientId=self.client)
-        v = _point_velocity(linear, angular, [com[0][i] - pose[0][i] for i in range(3)])
-        pybullet.resetBaseVelocity(self.body, v, angular, physicsClientId=self.client)
-
-    def shift(self, offset):
-        """Move the whole robot by ``offset`` (x, y, z) [m], world axes, keeping its velocities."""
-        com, orientation = pybullet.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
-        moved = tuple(com[i] + offset[i] for i in range(3))
-        pybullet.resetBasePositionAndOrientation(self.body, moved, orientation, physicsClientId=self.client)
-
-    def set_joint_positions(self, indices, positions):
-        """Joint angles [rad] set at rest (set_model_configuration)."""
-        for index, position in zip(indices, positions):
-            pybullet.resetJointState(self.body, index, position, 0.0, physicsClientId=self.client)
-
-    def reset(self):
-        """Back to the spawn pose with every joint at 0 and at rest."""
-        position, orientation = self.spawn
-        com = pybullet.multiplyTransforms(position, orientation,
-                                          *pybullet.invertTransform(*self._inertial_inv))
-        pybullet.resetBasePositionAndOrientation(self.body, com[0], com[1], physicsClientId=self.client)
-        pybullet.resetBaseVelocity(self.body, (0, 0, 0), (0, 0, 0), physicsClientId=self.client)
-        for index in self.joint_index.values():
-            pybullet.resetJointState(self.body, index, 0.0, 0.0, physicsClientId=self.client)
-

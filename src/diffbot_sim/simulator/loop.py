@@ -1,0 +1,374 @@
+"""The simulator's loop: one thread owns PyBullet and sim time; it steps the world, asks every robot's plugins
+what is due and publishes /clock and /tf (rospy). Subscriber and service callbacks only hand data to it
+(``call``/``post``); it knows no plugin by name."""
+import math
+import socket
+import threading
+import time
+
+import rospy
+from rosgraph_msgs.msg import Clock
+from std_srvs.srv import Empty, EmptyResponse
+from tf2_msgs.msg import TFMessage
+
+from diffbot_sim.ros import messages as ros_msgs
+from diffbot_sim.physics import World
+from diffbot_sim.plugins.base import next_due, publisher
+from diffbot_sim.simulator.throttle import Throttle
+
+
+class SubscriberLinks:
+    """Our publishers' TCP connections to subscribers: tuned once each, and batched in fast mode.
+
+    Publishers are synchronous (the loop's thread writes; no queue thread per connection, which costs
+    more CPU than the write itself), so a subscriber that stops reading must not stall the loop: each
+    connection gets a send timeout, after which rospy closes and drops it (the loop goes on, the
+    subscriber sees the connection end). TCP_NODELAY stops Nagle holding a small message for an ACK.
+
+    In fast mode, a message to a subscriber that is asleep costs ~100-150 us of wall time (the loopback
+    write wakes the receiver, a cross-CPU wake-up that is dear in a VM), far more than building it; so the
+    connections are corked (TCP_CORK) while the loop publishes and uncorked every ``batch`` wall seconds:
+    N writes become one wake-up per subscriber; messages and their order are unchanged, each arrives at
+    most ``batch`` late. Real-time mode does not batch.
+    """
+
+    def __init__(self, publishers, send_timeout, batch):
+        self.publishers = publishers  # callable returning the current publishers
+        self.send_timeout = send_timeout
+        self.batch = batch
+        self.held_since = None
+        self._tuned = set()
+        self._next_scan = 0.0
+
+    def _sockets(self):
+        for pub in self.publishers():
+            for conn in list(pub.impl.connections) if pub.impl is not None else ():
+                sock = getattr(conn, "socket", None)
+                if sock is not None and sock.family in (socket.AF_INET, socket.AF_INET6):
+                    yield sock
+
+    def tune_new(self, now_wall):
+        """Give new connections their send timeout and TCP_NODELAY (a scan at most every 0.1 s)."""
+        if now_wall < self._next_scan:
+            return
+        self._next_scan = now_wall + 0.1
+        live = set()  # the socket objects themselves: an id() could be reused by a later socket
+        for sock in self._sockets():
+            live.add(sock)
+            if sock not in self._tuned:
+                try:
+                    sock.settimeout(self.send_timeout)
+                    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+                except OSError:
+                    pass  # closing under us: rospy drops it on its next write
+        self._tuned = live
+
+    def _cork(self, value):
+        for sock in self._sockets():
+            try:
+                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_CORK, value)
+            except OSError:
+                pass
+
+    def hold(self, now_wall):
+        """Fast mode, before publishing: start a batch unless one is open."""
+        if self.batch > 0 and self.held_since is None:
+            self._cork(1)
+            self.held_since = now_wall
+
+    def release_if_due(self, now_wall):
+        if self.held_since is not None and now_wall - self.held_since >= self.batch:
+            self.release()
+
+    def release(self):
+        """Send everything held now (also before the loop pauses, and at close)."""
+        if self.held_since is not None:
+            self._cork(0)
+            self.held_since = None
+
+
+class RobotRuntime:
+    """One robot: its physics body and its plugins (one per Gazebo plugin, found through the registry).
+
+    The loop asks it what is due and calls it before and after each step; it knows no plugin by name.
+    """
+
+    def __init__(self, name, ctx, plugins):
+        self.name = name  # the model name the /gazebo services know it by
+        self.ctx = ctx
+        self.plugins = plugins
+
+    def close(self):
+        """Remove every topic and service of its plugins (delete_model)."""
+        self.ctx.close()
+
+    def publishers(self):
+        """This robot's publishers that the loop writes to."""
+        pubs = []
+        for plugin in self.plugins:
+            pubs += plugin.publishers()
+        return pubs
+
+    def next_publish(self):
+        """Sim time of this robot's next publication."""
+        return min((p.next_publish() for p in self.plugins), default=math.inf)
+
+    def next_due(self):
+        """Sim time of the next thing this robot must do (control or publishing)."""
+        return min([p.next_due() for p in self.plugins] + [self.next_publish()], default=math.inf)
+
+    def before_step(self, now):
+        for plugin in self.plugins:
+            plugin.before_step(now)
+
+    def after_step(self, now, stamp, transforms):
+        for plugin in self.plugins:
+            plugin.after_step(now, stamp, transforms)
+
+    def reset(self, now):
+        for plugin in self.plugins:
+            plugin.reset(now)
+
+    def start(self, now):
+        for plugin in self.plugins:
+            plugin.start(now)
+
+
+class Simulator:
+    """The single-threaded loop: apply commands -> step -> publish, paced to the wall clock or not."""
+
+    def __init__(self, cfg):
+        self.cfg = cfg
+        self.wake = threading.Event()
+        self.throttle = Throttle(5.0)
+        self.paused = False
+        self._requests = []
+        self._requests_lock = threading.Lock()
+        self.steps = 0
+        self.world = World(cfg.time_step, cfg.gravity, gui=cfg.gui)
+        self.clock_pub = publisher("/clock", Clock)
+        self.tf_pub = publisher("/tf", TFMessage)
+        self.robots = []
+        self.clock_period = 1.0 / cfg.clock_rate
+        self.next_clock = 0.0
+        self._next_publish = 0.0  # sim time of the earliest publication due, over clock and every robot
+        self._tf_msg = ros_msgs.tf_message([])
+        self._clock_msg = ros_msgs.clock(rospy.Time(0))
+        self.owns_clock = False  # main() sets it when use_sim_time made rospy follow /clock
+        self.world_description = None  # the world file's, when ~world names one
+        self.links = SubscriberLinks(self.publishers, cfg.send_timeout, 0.0 if cfg.real_time else cfg.fast_batch)
+        self.api = None  # the /gazebo world API (nodes.gazebo_api), when ~enable_ros_network
+        self.paused = cfg.paused
+
+    def publishers(self):
+        """Every publisher the loop writes to (SubscriberLinks tunes and batches their connections)."""
+        pubs = [self.clock_pub, self.tf_pub] + (self.api.publishers() if self.api is not None else [])
+        for runtime in self.robots:
+            pubs += runtime.publishers()
+        return pubs
+
+    def warn(self, key, text):
+        """A throttled warning (wall time): at most one per key per 5 s, with a count of what was held back."""
+        if self.throttle.ready(key, time.monotonic()):
+            held = self.throttle.take_suppressed(key)
+            rospy.logwarn(text + (f" ({held} more since the last warning)" if held else ""))
+
+    # -- requests from rospy's threads (services, subscribers): the loop does the work -----------------
+    def call(self, action, timeout=5.0):
+        """Run ``action()`` on the loop's thread (the only one that touches physics and plugins) and return
+        its result; an exception it raises is raised here. Works while paused.
+
+        Raises:
+            rospy.ServiceException: the loop did not get to it within ``timeout`` wall seconds.
+        """
+        done = threading.Event()
+        box = {}
+
+        def run():
+            try:
+                box["result"] = action()
+            except Exception as err:  # handed back to the caller's thread, raised there
+                box["error"] = err
+            done.set()
+        self.post(run)
+        if not done.wait(timeout):
+            raise rospy.ServiceException(f"the simulator loop did not handle the request within {timeout:g} s")
+        if "error" in box:
+            raise box["error"]
+        return box.get("result")
+
+    def post(self, action):
+        """Queue ``action()`` for the loop without waiting (a subscriber callback)."""
+        with self._requests_lock:
+            self._requests.append(action)
+        self.wake.set()
+
+    def _handle_requests(self):
+        with self._requests_lock:
+            requests, self._requests = self._requests, []
+        for action in requests:
+            action()
+
+    def pause(self):
+        self.paused = True
+
+    def unpause(self):
+        if self.paused:
+            self.paused = False
+            self._rebase()
+
+    def reset_world(self):
+        """gazebo_ros reset_world: every model back to its start pose at rest, plugins reset; sim time goes
+        on."""
+        self.world.reset()
+        now = self.sim_time
+        for runtime in self.robots:
+            runtime.reset(now)
+            runtime.start(now)
+        if self.api is not None:
+            self.api.wrenches.clear_all()
+
+    def reset_simulation(self):
+        """gazebo_ros reset_simulation: as reset_world, and sim time back to 0 (/clock jumps back, as in
+        Gazebo)."""
+        self.steps = 0
+        self.next_clock = 0.0
+        self._next_publish = 0.0
+        self.reset_world()
+        self._publish_clock(0.0)
+        self._rebase()
+
+    def add_robot(self, runtime, now=None):
+        """A robot joins the loop; one spawned while running starts at the current sim time."""
+        self.robots.append(runtime)
+        if now is not None:
+            runtime.start(now)
+            self._next_publish = min(self._next_publish, now)
+
+    def remove_robot(self, runtime):
+        """delete_model: the robot's topics, services and body go."""
+        self.robots.remove(runtime)
+        runtime.close()
+        self.world.remove_robot(runtime.ctx.robot)
+
+    def set_update_rate(self, rate):
+        """set_physics_properties' max_update_rate: steps per wall second (0: as fast as possible)."""
+        if rate > 0:
+            self.cfg.real_time, self.cfg.real_time_factor = True, rate * self.cfg.time_step
+        else:
+            self.cfg.real_time = False
+        self._rebase()
+
+    @property
+    def sim_time(self):
+        return self.steps * self.cfg.time_step
+
+    def _rebase(self):
+        """Re-anchor real-time pacing at the current sim time (after a pause or a start)."""
+        self.wall0 = time.monotonic()
+        self.sim0 = self.sim_time
+
+    def empty_service(self, action):
+        """A std_srvs/Empty handler's body: ``action`` run on the loop."""
+        self.call(action)
+        return EmptyResponse()
+
+    def advertise_services(self):
+        """The node's own ``~pause_physics``, ``~unpause_physics``, ``~reset_simulation`` and
+        ``~reset_world`` (the /gazebo ones' aliases, kept for launch files written for bullet_sim), unless
+        the node's private namespace is the /gazebo namespace (empty_world.launch names the node gazebo)."""
+        if rospy.get_name().rstrip("/") == self.cfg.gazebo_namespace.rstrip("/"):
+            return
+        for name, action in (("pause_physics", self.pause), ("unpause_physics", self.unpause),
+                             ("reset_simulation", self.reset_simulation), ("reset_world", self.reset_world)):
+            rospy.Service("~" + name, Empty, lambda _req, action=action: self.empty_service(action))
+
+    # -- the loop -----------------------------------------------------------------------------------
+    def run(self):
+        cfg = self.cfg
+        dt = cfg.time_step
+        for runtime in self.robots:
+            runtime.start(self.sim_time)
+        self._publish_clock(self.sim_time)
+        self._rebase()
+        while not rospy.is_shutdown():
+            self._handle_requests()
+            if self.paused:
+                # Gazebo keeps publishing /clock while paused: nodes that wait for a first /clock (the
+                # controller spawner, rospy.sleep) must not hang on a world started paused.
+                self._publish_clock(self.sim_time)
+                self.links.release()
+                self.wake.wait(0.1)
+                self.wake.clear()
+                continue
+            if cfg.real_time:
+                target = self.sim0 + (time.monotonic() - self.wall0) * cfg.real_time_factor
+                if self.sim_time + dt > target + 1e-9:
+                    # Sleep until the next thing due, or until a command wakes us. Publishing and control,
+                    # not stepping, set the wake rate, so CPU stays low.
+                    due = min([self.next_clock] + [r.next_due() for r in self.robots])
+                    # Wake at the step that reaches ``due`` (steps land on multiples of dt), not at ``due``
+                    # itself: waking between steps would only find nothing to do and sleep again.
+                    step_at = math.ceil(due / dt - 1e-6) * dt
+                    wait = (max(step_at, self.sim_time + dt) - target) / cfg.real_time_factor
+                    if self.wake.wait(min(max(wait, 0.0), 0.1)):
+                        self.wake.clear()
+                        # A command woke us: set the motor targets now rather than at the next step
+                        # (up to one step later). Same sim time, so the physics sees no difference.
+                        self._handle_requests()
+                        if not self.paused:
+                            for runtime in self.robots:
+                                runtime.before_step(self.sim_time)
+                    continue
+            self._step_once()
+
+    def _step_once(self):
+        now = self.sim_time
+        for runtime in self.robots:
+            runtime.before_step(now)
+        if self.api is not None:
+            self.api.before_step(now)
+        self.world.step()
+        self.steps += 1
+        now = self.sim_time
+        if now + 1e-9 < self._next_publish:
+            if self.links.held_since is not None:
+                self.links.release_if_due(time.monotonic())
+            return  # most steps publish nothing: skip building a stamp and asking every robot
+        stamp = self.stamp()
+        wall = time.monotonic()
+        self.links.tune_new(wall)
+        self.links.hold(wall)
+        transforms = []
+        for runtime in self.robots:
+            runtime.after_step(now, stamp, transforms)
+        if transforms and self.tf_pub.get_num_connections():
+            self._tf_msg.transforms = transforms
+            self.tf_pub.publish(self._tf_msg)
+        if self.api is not None:
+            self.api.after_step(now, stamp)
+        if now + 1e-9 >= self.next_clock:
+            self._publish_clock(now)
+        self._next_publish = min([self.next_clock] + [r.next_publish() for r in self.robots]
+                                 + ([self.api.next_publish()] if self.api is not None else []))
+        self.links.release_if_due(wall)
+
+    def stamp(self):
+        """Sim time as a rospy.Time, via integer nanoseconds (cheaper than Time.from_sec's float path)."""
+        secs, nsecs = divmod(round(self.steps * self.cfg.time_step * 1e9), 1_000_000_000)
+        return rospy.Time(secs, nsecs)
+
+    def _publish_clock(self, now):
+        stamp = self.stamp()
+        if self.owns_clock:
+            rospy.rostime._set_rostime(stamp)  # this node's own sim time (see _own_the_clock)
+        if self.clock_pub.get_num_connections():
+            self._clock_msg.clock = stamp
+            self.clock_pub.publish(self._clock_msg)
+        self.next_clock = next_due(self.next_clock, self.clock_period, now)
+
+    def close(self):
+        self.links.release()
+        if self.api is not None:
+            self.api.close()
+        self.world.close()

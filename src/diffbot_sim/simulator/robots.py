@@ -1,0 +1,200 @@
+"""Building bullet_sim's world and robots from its parameters, at start and when one is spawned at run time
+(/gazebo/spawn_urdf_model): each robot's model loaded, its ``<gazebo>`` plugins given to their modules
+(:mod:`diffbot_sim.plugins.registry`), and one start-up report of what was loaded and what was not (rospy)."""
+import os
+
+import rospy
+
+from diffbot_sim import config as cfgmod
+from diffbot_sim.description import meshes
+from diffbot_sim.description.model_files import load_file, package_path, parse_args
+from diffbot_sim.world.loading import load_world
+from diffbot_sim.errors import ModelError
+from diffbot_sim.description.urdf_model import parse_urdf, tag_value
+from diffbot_sim.description.plugin_tags import read_plugins
+from diffbot_sim.plugins import registry
+from diffbot_sim.plugins.base import RobotContext, get_param
+
+from diffbot_sim.simulator.loop import RobotRuntime, Simulator
+
+
+def _load_model(spec):
+    """URDF text and its source name: the spec's file, else ``/<name>/robot_description``, else the
+    ``robot_description`` parameter found from the node's namespace (one model shared by every robot)."""
+    if spec.model:
+        path = os.path.abspath(os.path.expanduser(spec.model))
+        return load_file(path, parse_args(spec.model_args)), path
+    name = f"/{spec.name}/robot_description" if spec.name else None
+    if name is None or not rospy.has_param(name):
+        name = rospy.search_param("robot_description")
+    if not name or not rospy.has_param(name):
+        raise ModelError("no ~model given and no robot_description parameter found",
+                         f"robot {spec.name}" if spec.name else "robot_description")
+    text = rospy.get_param(name)
+    if not isinstance(text, str) or not text.strip():
+        raise ModelError("parameter is empty or not a string", name)
+    return text, name
+
+
+class LoadedRobot:
+    """What build() learned about one robot, kept for the start-up report."""
+
+    def __init__(self, spec, model, plugins, runtime, notes):
+        self.spec, self.model, self.plugins, self.runtime, self.notes = spec, model, plugins, runtime, notes
+
+
+def _build_robot(sim, cfg, spec, params, loaded=None, pose=None, now=None):
+    """Load one robot and give each of its plugins to its module. ``loaded``: the URDF text and its source
+    name (default: the spec's model); ``pose``: its root link's world pose (default: the spec's x, y, z
+    raised onto the world, and yaw); ``now``: the sim time a robot spawned while running starts at."""
+    text, source = loaded or _load_model(spec)
+    model = parse_urdf(text, source)
+    base_dir = os.path.dirname(source) if os.path.isfile(source) else os.getcwd()
+    text, mesh_notes = meshes.prepare_meshes(text, source, base_dir, meshes.default_cache_dir(),
+                                             package_path)
+    found = read_plugins(model, known=registry.KNOWN, known_sensors=registry.KNOWN_SENSORS)
+    for trans in model.transmissions:
+        model.joint(trans.joint, f"/robot/transmission[@name='{trans.name}']")
+    if pose is None:
+        z = max(spec.z, sim.world.top_at(spec.x, spec.y)) if sim.world.world_bodies else spec.z
+        robot = sim.world.load_robot(text, model, (spec.x, spec.y, z), spec.yaw)
+        namespace = "/" + spec.name if spec.name else None
+    else:
+        robot = sim.world.load_robot(text, model, pose[0], orientation=pose[1])
+        namespace = None  # a spawn request's robot_namespace is already in its plugins' <robotNamespace>
+        if spec.tf_prefix is None:
+            spec.tf_prefix = _spawned_tf_prefix(model)
+    ctx = RobotContext(sim, cfg, spec, model, robot, params, namespace, f"~{spec.name}/" if spec.name else "~")
+    try:
+        runtime = RobotRuntime(spec.name or model.name, ctx, registry.build(ctx, found, params))
+    except BaseException:
+        ctx.close()
+        sim.world.remove_robot(robot)
+        raise
+    sim.add_robot(runtime, now)
+    return LoadedRobot(spec, model, found, runtime, model.warnings + mesh_notes + ctx.warnings)
+
+
+def spawn_robot(sim, cfg, params, name, text, source, pose):
+    """A robot spawned while running (/gazebo/spawn_urdf_model): every plugin, sensor and controller it
+    would get at start. Returns its RobotRuntime; raises DiffbotSimError on bad input."""
+    spec = cfgmod.RobotSpec(name=name)
+    item = _build_robot(sim, cfg, spec, params, loaded=(text, source), pose=pose, now=sim.sim_time)
+    _report_robot(cfg, item)
+    return item.runtime
+
+
+def _spawned_tf_prefix(model):
+    """A spawned robot's frames get the ``tf_prefix`` parameter of its plugins' namespace (the spawn
+    request's, once injected) when one is set, as gazebo_ros plugins read it; else none."""
+    for block in model.gazebo:
+        for element in block.element.iter("robotNamespace"):
+            namespace = tag_value(element)
+            if namespace:
+                return str(get_param(rospy.names.ns_join(namespace, "tf_prefix"), "")).strip("/")
+    return ""
+
+
+def _read_world(cfg):
+    """The world file's description (SDF .world, or a map_server .yaml), or None without ``~world``."""
+    return load_world(cfg.world, cfg.map_wall_height) if cfg.world else None
+
+
+def _apply_world_physics(cfg, world, params):
+    """A world's gravity and real_time_factor apply unless the node's parameters set them; its step does
+    not (ours is the measured one; ``~time_step`` chooses another)."""
+    if "gravity" not in params and world.gravity is not None:
+        cfg.gravity = world.gravity[2]
+        if abs(world.gravity[0]) > 1e-9 or abs(world.gravity[1]) > 1e-9:
+            world.not_simulated.append(f"horizontal gravity {world.gravity[:2]} (only its z is simulated)")
+    if "real_time_factor" not in params and world.real_time_factor:
+        cfg.real_time_factor = world.real_time_factor
+    if world.max_step_size:
+        world.not_simulated.append(f"physics max_step_size {world.max_step_size:g} s (the step is ~time_step, "
+                                   f"{cfg.time_step:g} s)")
+
+
+def build(cfg, params):
+    """Build the simulator with every robot of ``~robots`` (or the one robot); raises DiffbotSimError on
+    bad input, naming the robot's file, element or parameter."""
+    specs = cfgmod.robot_specs(cfg, params)
+    world = _read_world(cfg)
+    if world is not None:
+        _apply_world_physics(cfg, world, params)
+    sim = Simulator(cfg)
+    try:
+        if cfg.renderer == "egl":  # before any body exists: the EGL plugin draws only bodies made after it
+            reason = sim.world.use_egl()
+            if reason is not None:
+                rospy.logwarn(f"~renderer egl not available ({reason}); cameras use PyBullet's TinyRenderer")
+                cfg.renderer = "tiny"
+        if world is not None:
+            sim.world_description = world
+            sim.world.load_world(world, meshes.default_cache_dir())
+        loaded = [_build_robot(sim, cfg, spec, params) for spec in specs]
+    except BaseException:
+        sim.close()
+        raise
+    return sim, loaded
+
+
+def report(cfg, loaded, world=None):
+    """Log the effective configuration once and write it back to the private parameters."""
+    for key, value in cfgmod.as_params(cfg).items():
+        rospy.set_param("~" + key, value)
+    if cfg.physics_engine not in ("", "ode", "bullet"):
+        rospy.logwarn(f"bullet_sim: physics={cfg.physics_engine} accepted, not simulated (the engine is Bullet)")
+    if world is not None:
+        for text in world.warnings:
+            rospy.logwarn(f"world {world.source}: {text}")
+        if world.not_simulated:
+            rospy.logwarn(f"world {world.source}: not simulated (accepted): " + "; ".join(world.not_simulated))
+        rospy.set_param("~world_bodies", len(world.bodies))
+        rospy.loginfo(f"bullet_sim: world {world.source} ({world.name}): {len(world.bodies)} bodies, "
+                      f"{sum(1 for b in world.bodies if not b.static)} dynamic")
+    for item in loaded:
+        _report_robot(cfg, item)
+
+
+def _report_robot(cfg, item):
+    """Log one robot's warnings and effective settings; write them to its private parameters."""
+    found, model, runtime = item.plugins, item.model, item.runtime
+    who = f"robot {item.spec.name}: " if item.spec.name else ""
+    for text in found.warnings + item.notes:
+        rospy.logwarn(who + text)
+    if found.unsupported:
+        rospy.logwarn(who + "not simulated (ignored): " + "; ".join(found.unsupported))
+    for block in (found.diff_drive, found.joint_state):
+        if block is not None and block.unknown_tags:
+            rospy.logwarn(f"{who}{block.path}: unknown tags ignored: {', '.join(block.unknown_tags)}")
+    if not any(p.joints() or p.filename == "libgazebo_ros_planar_move.so" for p in runtime.plugins):
+        rospy.logwarn(who + "the model has no drive plugin or controller that bullet_sim simulates (and no "
+                      "~left_joints): nothing moves it")
+    params = {}
+    for plugin in runtime.plugins:
+        params.update(plugin.summary())
+    params["plugins"] = ",".join(p.filename for p in runtime.plugins)
+    params["loaded_mass"] = runtime.ctx.robot.total_mass()
+    params["urdf_mass"] = model.total_mass()
+    if item.spec.name:
+        params.update({k: v for k, v in cfgmod.as_params(item.spec).items() if k != "name"})
+    for key, value in params.items():
+        rospy.set_param(runtime.ctx.private + key.strip("/"), value)
+    params.update(cfgmod.as_params(cfg))
+    summary = ", ".join(f"{k}={v}" for k, v in sorted(params.items()))
+    rospy.loginfo(f"bullet_sim: {who}model {model.source} ({model.name}); {summary}")
+
+
+def world_api(sim, cfg, params):
+    """The /gazebo services and topics (None, with a warning, when gazebo_msgs is not built: the overlay
+    left out)."""
+    try:
+        from diffbot_sim.simulator.gazebo_services import GazeboApi
+    except ImportError as err:
+        rospy.logwarn(f"bullet_sim: no {cfg.gazebo_namespace} services ({err}; the gazebo_msgs overlay "
+                      "package is not built)")
+        return None
+    api = GazeboApi(sim, lambda name, text, source, pose: spawn_robot(sim, cfg, params, name, text, source,
+                                                                      pose))
+    api.advertise()
+    return api
