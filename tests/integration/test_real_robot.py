@@ -26,6 +26,7 @@ import threading
 import time
 import unittest
 
+import rosgraph
 import rospy
 import rostest
 from geometry_msgs.msg import Twist
@@ -113,6 +114,15 @@ class RealRobotTest(unittest.TestCase):
         self.pub.publish(Twist())
         return start, end, self.truth.between(start[1].header.stamp.to_sec(), end[1].header.stamp.to_sec())
 
+    def assert_legal_parameter_names(self):
+        """Every parameter bullet_sim writes (its start-up summary) is a legal ROS name: a plugin's summary
+        key once carried a space ('~imu /imu'), which rospy warns about and rosparam cannot address."""
+        import rosgraph.names
+
+        names = [n for n in rosgraph.Master("/test_real_robot").getParamNames() if n.startswith(SIM + "/")]
+        self.assertGreater(len(names), 5)
+        self.assertEqual([n for n in names if not rosgraph.names.is_legal_name(n)], [])
+
     def assert_ride(self, body, height, what):
         ride = drive_check.ride(body, height, what)
         rospy.loginfo(f"FIGURE body while {what}: height {ride.low:.4f}..{ride.high:.4f} m, tilt {ride.tilt:.4f} rad")
@@ -149,6 +159,7 @@ class RealRobotTest(unittest.TestCase):
         self.wait(lambda: self.odom.get() is not None and self.truth.get() is not None, 60.0,
                   "the robot's odometry and the ground truth")
         self.wait(lambda: self.pub.get_num_connections() > 0, 30.0, f"a subscriber on {self.cmd_topic}")
+        self.assert_legal_parameter_names()
         urdf_mass = rospy.get_param("~urdf_mass")
         self.assertAlmostEqual(rospy.get_param(SIM + "/urdf_mass"), urdf_mass, delta=1e-6)
         self.assertAlmostEqual(rospy.get_param(SIM + "/loaded_mass"), urdf_mass, delta=1e-3,

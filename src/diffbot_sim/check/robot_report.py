@@ -111,7 +111,8 @@ def _update(node, values):
 
 # --------------------------------------------------------------------------------------------- report
 
-def build_report(path, model_args="", controller_files=(), known=None, resolve_package=None, cache_dir=None):
+def build_report(path, model_args="", controller_files=(), known=(), known_sensors=(), resolve_package=None,
+                 cache_dir=None):
     """Load ``path`` as bullet_sim would and describe it.
 
     Args:
@@ -119,7 +120,8 @@ def build_report(path, model_args="", controller_files=(), known=None, resolve_p
         model_args: xacro arguments, ``"a:=1 b:=2"``.
         controller_files: ``[(file, tree)]``: each controller YAML and its parameters as loaded at ``/``
             (``rosparam.load_file``), in the order they are loaded.
-        known: plugin filenames bullet_sim simulates (``plugins.registry.KNOWN``); None imports it.
+        known, known_sensors: model and sensor plugin filenames bullet_sim simulates (``plugins.registry``'s
+            KNOWN and KNOWN_SENSORS: the caller passes them, this layer does not import the plugins).
         resolve_package: ``pkg -> path`` for ``package://`` meshes (LookupError when unknown); None: every
             package is unknown.
         cache_dir: converted-mesh cache; None: the user's (``meshes.default_cache_dir()``).
@@ -130,10 +132,6 @@ def build_report(path, model_args="", controller_files=(), known=None, resolve_p
     Raises:
         ModelError, ConfigError: what would stop bullet_sim, naming the file, element or parameter.
     """
-    known_sensors = ()
-    if known is None:
-        from diffbot_sim.plugins.registry import KNOWN as known  # imports the plugin modules (and rospy) only here
-        from diffbot_sim.plugins.registry import KNOWN_SENSORS as known_sensors
     source = os.path.abspath(os.path.expanduser(path))
     text = load_file(source, parse_args(model_args))
     model = parse_urdf(text, source)

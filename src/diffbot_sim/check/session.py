@@ -160,13 +160,6 @@ class Session:
         return [message(line) for line in self.sim.log().splitlines() if line.startswith("[WARN]")]
 
     def __exit__(self, *exc):
-        try:
-            import rospy
-
-            if rospy.core.is_initialized():
-                rospy.signal_shutdown("robot_check done")
-        except ImportError:
-            pass
         if self.sim is not None:
             self.sim.stop(5.0)
         if self.master is not None:

@@ -99,9 +99,9 @@ def _main(argv):
     yamls = [os.path.abspath(os.path.expanduser(y)) for y in yamls]
     try:
         files = [(path, _load_yaml(path)) for path in yamls]
-        from diffbot_sim.plugins.registry import KNOWN
+        from diffbot_sim.plugins.registry import KNOWN, KNOWN_SENSORS  # the plugin modules (rospy): here only
         report = robot_report.build_report(model, model_args, [(p, tree) for p, (tree, _) in files], KNOWN,
-                                           package_path)
+                                           KNOWN_SENSORS, package_path)
     except DiffbotSimError as err:
         streams.write(sys.stderr, f"robot_check: {err}\n")
         return 1
@@ -113,13 +113,24 @@ def _main(argv):
     signal.signal(signal.SIGTERM, _terminate)
     try:
         with Session(model, model_args, [docs for _, (_, docs) in files]) as session:
-            return _drive(session, report)
+            try:
+                return _drive(session, report)
+            finally:
+                _leave_ros()  # before the session stops the master this node talks to
     except SessionError as err:
         _say(f"result: FAIL: {err}")
         return 1
     except KeyboardInterrupt as err:
         streams.write(sys.stderr, "robot_check: interrupted\n")
         return 128 + (err.args[0] if err.args else signal.SIGINT)
+
+
+def _leave_ros():
+    """Shut this process's node down (when the drive got as far as starting it)."""
+    import rospy
+
+    if rospy.core.is_initialized():
+        rospy.signal_shutdown("robot_check done")
 
 
 def _terminate(signum, frame):

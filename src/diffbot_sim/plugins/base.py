@@ -4,6 +4,7 @@ The loop is single-threaded: subscriber callbacks (rospy's threads) only store d
 ``before_step``/``after_step`` run on the loop's thread, the only one that touches the physics.
 """
 import math
+import re
 import warnings
 from dataclasses import dataclass
 from typing import Optional
@@ -35,6 +36,15 @@ def join(namespace, name):
     if name.startswith("/") or not namespace:
         return name
     return namespace.rstrip("/") + "/" + name.lstrip("/")
+
+
+def summary_key(kind, name):
+    """A start-up summary key, ``<kind>/<name>``, that is a legal ROS parameter name whatever the model called
+    the sensor or its topic (rospy warns about, and rosparam cannot address, a name with a space or a
+    hyphen): each run of other characters becomes one ``_``, and a part must not start with a digit."""
+    parts = [re.sub(r"[^A-Za-z0-9_]+", "_", part) for part in str(name).split("/") if part]
+    parts = [part if part[:1].isalpha() else "n" + part for part in parts if part.strip("_")] or ["unnamed"]
+    return "/".join([kind] + parts)
 
 
 def next_due(due, period, now):

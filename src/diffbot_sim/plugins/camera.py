@@ -17,6 +17,7 @@ CPU TinyRenderer) or ``egl`` (OpenGL off screen; falls back to tiny with one war
 """
 from sensor_msgs.msg import CameraInfo, Image
 
+from diffbot_sim.plugins.base import summary_key
 from diffbot_sim.plugins.camera_base import CameraBase
 from diffbot_sim.plugins.depth import DepthCamera
 from diffbot_sim.ros import messages as ros_msgs
@@ -49,7 +50,7 @@ class Camera(CameraBase):
 
     def summary(self):
         out = super().summary()
-        out[f"camera/{self.cfg.name}/image_topic"] = self.image_pub.resolved_name
+        out[summary_key("camera", self.cfg.name) + "/image_topic"] = self.image_pub.resolved_name
         return out
 
 

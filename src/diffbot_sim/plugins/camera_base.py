@@ -1,7 +1,7 @@
 """What the camera and depth-camera plugins share: the sensor's pose, timing, rendering and CameraInfo
 (:mod:`diffbot_sim.plugins.camera`, :mod:`diffbot_sim.plugins.depth`)."""
 from diffbot_sim.errors import PluginNotLoaded
-from diffbot_sim.plugins.base import Plugin, join
+from diffbot_sim.plugins.base import Plugin, join, summary_key
 from diffbot_sim.sensors import camera as cam
 
 
@@ -100,4 +100,4 @@ class CameraBase(Plugin):
         return True
 
     def summary(self):
-        return {f"camera/{self.cfg.name}": cam.describe(self.cfg, self.renderer)}
+        return {summary_key("camera", self.cfg.name): cam.describe(self.cfg, self.renderer)}

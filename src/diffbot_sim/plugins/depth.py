@@ -18,6 +18,7 @@ from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 
 from diffbot_sim.sensors import camera as cam
 from diffbot_sim.ros import messages as ros_msgs
+from diffbot_sim.plugins.base import summary_key
 from diffbot_sim.plugins.camera_base import CameraBase
 
 
@@ -91,8 +92,8 @@ class DepthCamera(CameraBase):
 
     def summary(self):
         out = super().summary()
-        out[f"camera/{self.cfg.name}/depth_topic"] = self.depth_pub.resolved_name
-        out[f"camera/{self.cfg.name}/points_topic"] = self.points_pub.resolved_name
+        out[summary_key("camera", self.cfg.name) + "/depth_topic"] = self.depth_pub.resolved_name
+        out[summary_key("camera", self.cfg.name) + "/points_topic"] = self.points_pub.resolved_name
         return out
 
 

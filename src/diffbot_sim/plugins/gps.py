@@ -27,7 +27,7 @@ from diffbot_sim.sensors import noise
 from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.errors import ModelError, PluginNotLoaded
 from diffbot_sim.values import check_bool, tag_number
-from diffbot_sim.plugins.base import Plugin, join
+from diffbot_sim.plugins.base import Plugin, join, summary_key
 from diffbot_sim.description.plugin_tags import read_tags
 
 FILENAME = "libhector_gazebo_ros_gps.so"
@@ -155,7 +155,7 @@ class Gps(Plugin):
     def summary(self):
         lat, lon, heading, alt = self.v["reference"]
         rate = f"{round(1.0 / self.v['period'], 3)} Hz" if self.v["period"] > 0 else "every step"
-        return {f"gps {self.fix_pub.resolved_name}": f"velocity {self.vel_pub.resolved_name}, body "
+        return {summary_key("gps", self.fix_pub.resolved_name): f"velocity {self.vel_pub.resolved_name}, body "
                 f"{self.v['body']}, reference {lat} deg, {lon} deg, heading {heading} deg, {alt} m, {rate}"}
 
 

@@ -44,7 +44,7 @@ from diffbot_sim.description.plugin_tags import read_tags, vector
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.values import check_bool, tag_number
 from diffbot_sim.transforms import qconj, qmul, qnormalize, rpy_quaternion
-from diffbot_sim.plugins.base import Plugin, join
+from diffbot_sim.plugins.base import Plugin, join, summary_key
 
 SENSOR_FILENAME = "libgazebo_ros_imu_sensor.so"
 MODEL_FILENAME = "libgazebo_ros_imu.so"
@@ -400,7 +400,7 @@ class ImuPlugin(Plugin):
     def summary(self):
         s = self.s
         rate = f"{round(1.0 / s.period, 3)} Hz" if s.period > 0 else "every step"
-        return {f"imu {self.pub.resolved_name}": f"link {s.link}, frame {self.frame_id}, {rate}"}
+        return {summary_key("imu", self.pub.resolved_name): f"link {s.link}, frame {self.frame_id}, {rate}"}
 
 
 def _wrap(ctx, fn, *args):

@@ -28,7 +28,7 @@ from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.errors import ConfigError
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.values import check_string, tag_number
-from diffbot_sim.plugins.base import Plugin, join
+from diffbot_sim.plugins.base import Plugin, join, summary_key
 
 ROS1_LASERS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so")
 ROS2_RAY = "libgazebo_ros_ray_sensor.so"
@@ -122,7 +122,7 @@ class RaySensorPlugin(Plugin):
 
     def describe(self, topic, frame):
         rate = f"{self.cfg.update_rate:g} Hz" if self.cfg.update_rate > 0 else "every step"
-        return {f"sensor/{self.name}": f"{self.filename} topic {topic} frame {frame} rays {self.cfg.rays} "
+        return {summary_key("sensor", self.name): f"{self.filename} topic {topic} frame {frame} rays {self.cfg.rays} "
                                        f"readings {self.cfg.readings} {rate}"}
 
 

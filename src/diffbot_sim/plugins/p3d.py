@@ -16,7 +16,7 @@ from diffbot_sim.sensors import noise
 from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.errors import ModelError, PluginNotLoaded
 from diffbot_sim.values import tag_number
-from diffbot_sim.plugins.base import Plugin, join
+from diffbot_sim.plugins.base import Plugin, join, summary_key
 from diffbot_sim.description.plugin_tags import read_tags, vector
 from diffbot_sim.transforms import qconj, qmul, qnormalize, rotate, rpy_quaternion
 
@@ -107,7 +107,7 @@ class P3D(Plugin):
 
     def summary(self):
         rate = f"{round(1.0 / self.v['period'], 3)} Hz" if self.v["period"] > 0 else "every step"
-        return {f"p3d {self.pub.resolved_name}": f"body {self.v['body']}, frame {self.frame_id}, {rate}"}
+        return {summary_key("p3d", self.pub.resolved_name): f"body {self.v['body']}, frame {self.frame_id}, {rate}"}
 
 
 def create(ctx, element, path, params):

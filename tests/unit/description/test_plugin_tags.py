@@ -11,7 +11,7 @@ def _gazebo(*plugins):
     return "\n  <gazebo>" + "".join(plugins) + "</gazebo>"
 
 
-with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "ros1_diff_drive.xml")) as _f:
+with open(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "ros1_diff_drive.xml")) as _f:
     ROS1_DIFF_DRIVE = _f.read()
 
 

@@ -10,7 +10,7 @@ import pytest
 from diffbot_sim.sensors import ray as rs
 from diffbot_sim.errors import ConfigError
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LASER_URDF = os.path.join(os.path.dirname(HERE), "data", "robots", "laser_robot.urdf")
 
 

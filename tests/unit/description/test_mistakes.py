@@ -16,7 +16,7 @@ from diffbot_sim.plugins import registry
 from diffbot_sim.plugins.base import RobotContext
 from diffbot_sim.description.plugin_tags import read_plugins
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 MISTAKES = os.path.join(ROOT, "tests", "data", "robots", "mistakes.urdf")
 URDF_MASS = 0.8 + 2 * 0.1 + 0.0017 + 0.05  # base, wheels, caster, laser (the fixture's comment)
 

@@ -238,3 +238,14 @@ def test_gazebo_reference_naming_nothing_warns_once(parse):
     assert len(model.warnings) == 1
     assert "caster_{side}_1_joint" in model.warnings[0] and "names no link or joint" in model.warnings[0]
     assert model.surface("wheel") == {"mu1": 0.1}
+
+
+@pytest.mark.parametrize("kind, name, key", [
+    ("imu", "/imu", "imu/imu"), ("imu", "/robot1/imu data", "imu/robot1/imu_data"), ("sensor", "laser-front", "sensor/laser_front"),
+    ("camera", "3d cam", "camera/n3d_cam"), ("gps", "", "gps/unnamed"),
+])
+def test_summary_keys_are_legal_ros_names(kind, name, key):
+    import rosgraph.names
+
+    from diffbot_sim.plugins.base import summary_key
+    assert summary_key(kind, name) == key and rosgraph.names.is_legal_name(key)

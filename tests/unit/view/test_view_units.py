@@ -81,7 +81,7 @@ def template():
 
 def rviz_config_path():
     import os
-    return os.path.join(os.path.dirname(__file__), "..", "..", "rviz", "diffbot.rviz")
+    return os.path.join(os.path.dirname(__file__), "..", "..", "..", "rviz", "diffbot.rviz")
 
 
 def test_config_for_one_robot_with_sensors():

@@ -17,7 +17,7 @@ from diffbot_sim.plugins.base import RobotContext
 from diffbot_sim.description.plugin_tags import SensorElement
 from diffbot_sim.world.bodies import Body, Shape, WorldDescription
 
-LASER_URDF = os.path.join(os.path.dirname(__file__), "..", "data", "robots", "laser_robot.urdf")
+LASER_URDF = os.path.join(os.path.dirname(__file__), "..", "..", "data", "robots", "laser_robot.urdf")
 FACE = 2.9 - 0.05  # the wall's face at x = 2.9, the laser link 0.05 m ahead of base_link
 SENSOR = ('<sensor type="ray" name="lidar"><update_rate>10</update_rate><ray><scan>'
           '<horizontal><samples>8</samples><min_angle>-0.2</min_angle><max_angle>0.2</max_angle></horizontal>'

@@ -236,7 +236,7 @@ def test_controller_and_encoder_odometry_track_physics(seed):
 # tests/data/robots/inertial_link_4wd.urdf: an inertia-less base_link whose geometry rests at z 0.13228 (the
 # wheels, radius 0.1651, hang 0.03282 above base_link), stiff undamped wheel contacts (kp 1e7, kd 1).
 
-FOUR_WD = os.path.join(os.path.dirname(__file__), "..", "data", "robots", "inertial_link_4wd.urdf")
+FOUR_WD = os.path.join(os.path.dirname(__file__), "..", "..", "data", "robots", "inertial_link_4wd.urdf")
 REST_Z = 0.13228
 
 

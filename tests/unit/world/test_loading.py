@@ -8,7 +8,7 @@ from diffbot_sim.errors import ModelError
 from diffbot_sim.world.loading import resolve_world_path
 from diffbot_sim.world.sdf_reader import read_world
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 
 
 def test_gazebo_default_world_is_ours(monkeypatch, tmp_path):

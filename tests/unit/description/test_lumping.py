@@ -18,7 +18,7 @@ from diffbot_sim.description.model_files import load_file
 from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.physics import World
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 ROBOTS = os.path.join(ROOT, "tests", "data", "robots")
 FIXED_CASTER = os.path.join(ROBOTS, "fixed_caster.urdf")
 SEED_XACRO = os.path.join(ROOT, "urdf", "diffbot.urdf.xacro")

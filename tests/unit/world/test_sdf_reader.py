@@ -15,7 +15,7 @@ from diffbot_sim.transforms import compose, inverse, rpy_quaternion
 from diffbot_sim.world.model_paths import env_model_paths, ros_package_model_paths
 from diffbot_sim.world.sdf_reader import read_world
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 ROOM = os.path.join(ROOT, "worlds", "room.world")
 ROOM_MODELS = os.path.join(ROOT, "worlds", "models")
 

@@ -5,12 +5,13 @@ import os
 import pytest
 import yaml
 
+from diffbot_sim.plugins.registry import KNOWN, KNOWN_SENSORS
 from diffbot_sim.check import drive_check
 
 from diffbot_sim.check import robot_report
 from diffbot_sim.errors import ConfigError, ModelError
 
-ROBOTS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "robots")
+ROBOTS = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "data", "robots")
 
 
 def robot(name):
@@ -33,7 +34,7 @@ def report(tmp_path):
             path = str(tmp_path / model)
             with open(path, "w") as handle:
                 handle.write(text)
-        return robot_report.build_report(path, "", controllers(*yamls), cache_dir=str(tmp_path / "cache"))
+        return robot_report.build_report(path, "", controllers(*yamls), KNOWN, KNOWN_SENSORS, cache_dir=str(tmp_path / "cache"))
     return build
 
 
@@ -91,7 +92,7 @@ def test_pid_robot_warns_about_its_sim_type_and_frame(report):
 def test_yaml_geometry_is_named_with_its_file(report, tmp_path):
     tree = yaml.safe_load(open(robot("pid_robot.yaml")))
     tree["diff_controller"].update(wheel_separation=0.3, wheel_radius=0.04)
-    r = robot_report.build_report(robot("pid_robot.urdf"), "", [("/x/mine.yaml", tree)],
+    r = robot_report.build_report(robot("pid_robot.urdf"), "", [("/x/mine.yaml", tree)], KNOWN, KNOWN_SENSORS,
                                   cache_dir=str(tmp_path))
     assert r.drive.separation == pytest.approx(0.3)
     assert r.drive.separation_from == "/diff_controller/wheel_separation in mine.yaml"
@@ -145,7 +146,8 @@ def test_a_bad_controller_parameter_is_named(report, tmp_path):
     tree = yaml.safe_load(open(robot("pid_robot.yaml")))
     tree["diff_controller"]["wheel_radius"] = -1
     with pytest.raises(ConfigError, match="/diff_controller/wheel_radius"):
-        robot_report.build_report(robot("pid_robot.urdf"), "", [("c.yaml", tree)], cache_dir=str(tmp_path))
+        robot_report.build_report(robot("pid_robot.urdf"), "", [("c.yaml", tree)], KNOWN, KNOWN_SENSORS,
+                                  cache_dir=str(tmp_path))
 
 
 @pytest.mark.parametrize("model, yamls", [("fixed_caster.urdf", ()), ("kobuki_style.urdf", ()),

@@ -19,7 +19,7 @@ from diffbot_sim.description import xacro_compat
 from diffbot_sim.description.model_files import load_file
 from diffbot_sim.errors import ModelError
 
-DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "xacro")
+DATA = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "xacro")
 XACRO_NS = "http://www.ros.org/wiki/xacro"
 
 
