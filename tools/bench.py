@@ -139,8 +139,9 @@ def sim_args(*extra):
 # Each runs in its own process, as one ROS node, and prints one JSON line.
 
 def _sim_pid():
-    import rosnode
     import xmlrpc.client
+
+    import rosnode
     uri = rosnode.get_api_uri(rosnode.rosgraph.Master("/bench"), "/bullet_sim", skip_cache=True)
     return xmlrpc.client.ServerProxy(uri).getPid("/bench")[2]
 
@@ -350,6 +351,7 @@ def bench_bare_paced(seconds):
     """The same model stepped by PyBullet alone but paced to the wall clock, waking every 10 ms (the
     simulator's publish period) to run the steps due: the floor under the simulator's real-time CPU."""
     import threading
+
     import pybullet
     sys.path.insert(0, os.path.join(ROOT, "src"))
     from diffbot_sim.description.model_files import load_file

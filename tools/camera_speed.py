@@ -43,9 +43,9 @@ def bare(frames):
     """Images per second of pybullet.getCameraImage alone, the node's view of the same scene."""
     import pybullet
 
-    from diffbot_sim.sensors import camera as cam
     from diffbot_sim.description.urdf_model import parse_urdf
     from diffbot_sim.physics import World
+    from diffbot_sim.sensors import camera as cam
     from diffbot_sim.world.sdf_reader import read_world
 
     world = World(1.0 / 240.0)

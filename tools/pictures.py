@@ -180,8 +180,8 @@ class Recorder:
 
 
 def main():
-    from diffbot_sim.view import plot_data
     from diffbot_sim.nodes import plot_run
+    from diffbot_sim.view import plot_data
 
     os.makedirs(DOCS, exist_ok=True)
     logs = os.path.join(ROOT, "test-results", "pictures")

@@ -10,8 +10,7 @@ import unittest
 
 import rospy
 import rostest
-
-from simtest import Recorder, Truth, reset_robot, yaw_of, finite_odom
+from simtest import Recorder, Truth, finite_odom, reset_robot, yaw_of
 
 RADIUS = 0.032
 SEPARATION = 0.2

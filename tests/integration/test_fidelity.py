@@ -7,7 +7,6 @@ import unittest
 
 import rospy
 import rostest
-
 from simtest import SIM, Recorder, reset_robot, yaw_of
 
 

@@ -25,7 +25,6 @@ import rospy
 import rostest
 from geometry_msgs.msg import TwistStamped
 from rosgraph_msgs.msg import Clock
-
 from simtest import SIM, Recorder, alive, figure, node_pid, rss_kib
 
 FLOODERS = 3

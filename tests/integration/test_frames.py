@@ -6,7 +6,6 @@ import unittest
 import rospy
 import rostest
 import tf2_ros
-
 from simtest import Recorder
 
 

@@ -20,13 +20,12 @@ import rospy
 import rostest
 from gazebo_msgs import msg as gmsg
 from gazebo_msgs import srv as gsrv
-from geometry_msgs.msg import Point, Pose, Quaternion, Twist, Wrench, Vector3
+from geometry_msgs.msg import Point, Pose, Quaternion, Twist, Vector3, Wrench
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
-from std_srvs.srv import Empty
-
 from simtest import Latest, assert_upright, yaw_of
 from simtest import wait_for as wait
+from std_srvs.srv import Empty
 
 GZ = "/gazebo"
 ROBOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "robots", "fixed_caster.urdf")

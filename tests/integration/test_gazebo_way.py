@@ -18,7 +18,6 @@ from gazebo_msgs.srv import GetModelState, GetWorldProperties
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState, LaserScan
-
 from simtest import Latest, assert_upright, yaw_of
 from simtest import wait_for as wait
 

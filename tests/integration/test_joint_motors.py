@@ -7,9 +7,8 @@ import unittest
 
 import rospy
 import rostest
-from std_msgs.msg import Float64
-
 from simtest import Recorder
+from std_msgs.msg import Float64
 
 
 class JointMotorsTest(unittest.TestCase):

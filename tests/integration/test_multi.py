@@ -9,8 +9,7 @@ import rospy
 import rostest
 import tf2_ros
 from geometry_msgs.msg import Twist
-
-from simtest import Recorder, Truth, yaw_of, finite_odom
+from simtest import Recorder, Truth, finite_odom, yaw_of
 
 SIM = "/bullet_sim"
 

@@ -6,8 +6,7 @@ import unittest
 
 import rospy
 import rostest
-
-from simtest import Recorder, reset_robot, finite_odom
+from simtest import Recorder, finite_odom, reset_robot
 
 FIELDS = ("linear_x", "linear_y", "linear_z", "angular_x", "angular_y", "angular_z")
 

@@ -8,7 +8,6 @@ import unittest
 
 import rospy
 import rostest
-
 from simtest import SIM, Recorder, call
 
 

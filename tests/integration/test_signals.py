@@ -23,7 +23,6 @@ import rospkg
 import rospy
 import rostest
 from geometry_msgs.msg import Twist
-
 from simtest import Recorder, alive, figure, node_pid, session_pids
 from test_teleop_pty import READY_TEXT, PtyReader
 

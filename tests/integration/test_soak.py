@@ -19,9 +19,8 @@ import rostest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock, Log
-from std_srvs.srv import Empty
-
 from simtest import SIM, alive, figure, finite_odom, node_pid, rss_kib
+from std_srvs.srv import Empty
 
 SIM_SECONDS = 3600.0
 WARM_UP = 60.0  # sim s before the memory baseline

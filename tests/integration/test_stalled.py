@@ -17,7 +17,6 @@ import rosgraph
 import rospy
 import rostest
 from rosgraph_msgs.msg import Clock
-
 from simtest import figure
 
 SUBSCRIBER = """

@@ -17,7 +17,6 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import viewtest  # noqa: E402
 from test_view_rviz import START_TIMEOUT, ViewRviz  # noqa: E402
 
-
 ROBOT2 = (0.0, 1.0)  # m, multi.launch's spawn pose of robot2; robot1 (the fixed frame's) is at the origin
 
 

@@ -26,9 +26,10 @@ import rostest
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import viewtest  # noqa: E402
 
-from diffbot_sim.view import rviz_config  # noqa: E402
-
-from diffbot_sim.view import xscreen
+from diffbot_sim.view import (
+    rviz_config,  # noqa: E402
+    xscreen,
+)
 
 START_TIMEOUT = 60.0  # s wall: master, simulator, rviz under llvmpipe on a busy 2-core machine
 SETTLE_TIMEOUT = 30.0  # s wall: displays Ok and two equal frames after a config load

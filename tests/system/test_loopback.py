@@ -13,9 +13,19 @@ import shutil
 import signal
 
 import pytest
-
-from proctools import (MODEL, Master, Proc, alive, base_env, comm, environ, free_port, is_loopback, listening_sockets,
-                       wait_for)
+from proctools import (
+    MODEL,
+    Master,
+    Proc,
+    alive,
+    base_env,
+    comm,
+    environ,
+    free_port,
+    is_loopback,
+    listening_sockets,
+    wait_for,
+)
 
 # roscpp (Debian's build) binds the XML-RPC server to all interfaces: the only sockets allowed off loopback.
 KNOWN_EXCEPTIONS = {"/rosout": "roscpp XML-RPC server", "/robot_state_publisher": "roscpp XML-RPC server"}

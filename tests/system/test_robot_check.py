@@ -8,7 +8,6 @@ import os
 import subprocess
 
 import pytest
-
 from proctools import ROOT, SETUP, base_env, environ
 
 ROBOTS = os.path.join(ROOT, "tests", "data", "robots")

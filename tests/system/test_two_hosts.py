@@ -12,7 +12,6 @@ import signal
 import subprocess
 
 import pytest
-
 from proctools import MODEL, Proc, base_env, wait_for
 
 START_TIMEOUT = 60.0

@@ -5,10 +5,16 @@ import os
 import pytest
 
 from diffbot_sim import config
-from diffbot_sim.config import (FALLBACK_MAX_WHEEL_VELOCITY, SimConfig, as_params, drive_config,
-                                joint_state_config, sim_config)
-from diffbot_sim.errors import ConfigError, ModelError
+from diffbot_sim.config import (
+    FALLBACK_MAX_WHEEL_VELOCITY,
+    SimConfig,
+    as_params,
+    drive_config,
+    joint_state_config,
+    sim_config,
+)
 from diffbot_sim.description.plugin_tags import read_plugins
+from diffbot_sim.errors import ConfigError, ModelError
 
 with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "ros1_diff_drive.xml")) as _f:
     ROS1_DIFF_DRIVE = _f.read()
@@ -339,10 +345,11 @@ def test_sim_config_rejects(key, value):
 # --- wheel limits resolved from params, URDF and fallback (config.max_wheel_velocity / wheel_efforts) ---
 
 def _seed_drive():
-    from diffbot_sim.description.model_files import load_file
-    from diffbot_sim.description.urdf_model import parse_urdf
-    from diffbot_sim.description.plugin_tags import read_plugins
     import os
+
+    from diffbot_sim.description.model_files import load_file
+    from diffbot_sim.description.plugin_tags import read_plugins
+    from diffbot_sim.description.urdf_model import parse_urdf
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     model = parse_urdf(load_file(os.path.join(root, "urdf", "diffbot.urdf.xacro")))
     return model, config.drive_config(model, read_plugins(model).diff_drive, {})

@@ -1,8 +1,15 @@
 """config.py: the ~robots list (several namespaced robots in one simulator), frame prefixes, namespacing."""
 import pytest
 
-from diffbot_sim.config import (DriveConfig, JointStateConfig, RobotSpec, SimConfig, place_in_namespace,
-                                prefix_frame, robot_specs)
+from diffbot_sim.config import (
+    DriveConfig,
+    JointStateConfig,
+    RobotSpec,
+    SimConfig,
+    place_in_namespace,
+    prefix_frame,
+    robot_specs,
+)
 from diffbot_sim.errors import ConfigError
 
 

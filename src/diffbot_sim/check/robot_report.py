@@ -15,11 +15,11 @@ from typing import List, Optional, Tuple
 
 from diffbot_sim import config as cfgmod
 from diffbot_sim.control import diff_drive_controller as ddc
-from diffbot_sim.description import meshes
 from diffbot_sim.control.controller_lookup import find_controllers
+from diffbot_sim.description import meshes
 from diffbot_sim.description.model_files import load_file, parse_args
-from diffbot_sim.description.urdf_model import parse_urdf, tag_value
 from diffbot_sim.description.plugin_tags import DIFF_DRIVE, JOINT_STATE, read_plugins
+from diffbot_sim.description.urdf_model import parse_urdf, tag_value
 
 SKID_STEER = "libgazebo_ros_skid_steer_drive.so"
 PLANAR_MOVE = "libgazebo_ros_planar_move.so"

@@ -11,10 +11,10 @@ import math
 from dataclasses import asdict, dataclass, field
 from typing import NamedTuple, Optional, Tuple
 
-from diffbot_sim.errors import ConfigError
 from diffbot_sim.control.kinematics import wheel_speeds
 from diffbot_sim.control.limits import SpeedLimiter
 from diffbot_sim.control.odometry import EncoderOdometry
+from diffbot_sim.errors import ConfigError
 
 CONTROLLER_TYPE = "diff_drive_controller/DiffDriveController"
 

@@ -240,7 +240,7 @@ def parse_urdf(text, source="robot_description"):
         joints[jname] = Joint(jname, jtype, parent, child, xyz, rpy, axis, effort, velocity)
 
     children = {j.child for j in joints.values()}
-    roots = [l for l in links if l not in children]
+    roots = [name for name in links if name not in children]
     if len(roots) != 1:
         raise ModelError(f"must have exactly one root link, found {len(roots)}: {', '.join(roots)}", source, "/robot")
 

@@ -16,7 +16,6 @@ import math
 from diffbot_sim.gazebo.ignition import add, cross, floats, sub, unit, unit_pose, unrotate
 from diffbot_sim.transforms import compose, inverse, rotate
 
-
 # ------------------------------------------------------------------------------------------ frames
 
 #: Reference-frame names every service (spawn, get/set model and link state, apply_body_wrench) takes for

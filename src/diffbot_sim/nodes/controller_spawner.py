@@ -23,11 +23,20 @@ import threading
 import time
 
 import rospy
-from controller_manager_msgs.srv import (ListControllers, ListControllersRequest, ListControllerTypes,
-                                         ListControllerTypesRequest, LoadController, LoadControllerRequest,
-                                         ReloadControllerLibraries, ReloadControllerLibrariesRequest,
-                                         SwitchController, SwitchControllerRequest, UnloadController,
-                                         UnloadControllerRequest)
+from controller_manager_msgs.srv import (
+    ListControllers,
+    ListControllersRequest,
+    ListControllerTypes,
+    ListControllerTypesRequest,
+    LoadController,
+    LoadControllerRequest,
+    ReloadControllerLibraries,
+    ReloadControllerLibrariesRequest,
+    SwitchController,
+    SwitchControllerRequest,
+    UnloadController,
+    UnloadControllerRequest,
+)
 from std_msgs.msg import Bool
 
 from diffbot_sim.gazebo import cli as gazebo_cli

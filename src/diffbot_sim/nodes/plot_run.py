@@ -21,7 +21,6 @@ import threading
 import time
 
 from diffbot_sim import streams
-
 from diffbot_sim.view import plot_data
 
 

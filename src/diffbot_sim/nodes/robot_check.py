@@ -25,10 +25,7 @@ import threading
 import time
 
 from diffbot_sim import streams
-
-from diffbot_sim.check import drive_check
-
-from diffbot_sim.check import robot_report
+from diffbot_sim.check import drive_check, robot_report
 from diffbot_sim.check.session import SIM, Session, SessionError
 from diffbot_sim.description.model_files import package_path
 from diffbot_sim.errors import DiffbotSimError, ModelError

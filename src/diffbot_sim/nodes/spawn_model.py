@@ -21,8 +21,14 @@ import threading
 
 import rospy
 from gazebo_msgs.msg import ModelStates
-from gazebo_msgs.srv import (DeleteModel, DeleteModelRequest, SetModelConfiguration,
-                             SetModelConfigurationRequest, SpawnModel, SpawnModelRequest)
+from gazebo_msgs.srv import (
+    DeleteModel,
+    DeleteModelRequest,
+    SetModelConfiguration,
+    SetModelConfigurationRequest,
+    SpawnModel,
+    SpawnModelRequest,
+)
 from geometry_msgs.msg import Pose
 from std_srvs.srv import Empty, EmptyRequest
 

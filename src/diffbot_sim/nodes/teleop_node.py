@@ -32,11 +32,11 @@ import rospy
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
-from diffbot_sim.errors import ConfigError, TerminalError
 from diffbot_sim import streams
+from diffbot_sim.control.kinematics import yaw_from_quaternion
+from diffbot_sim.errors import ConfigError, TerminalError
 from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.teleop.keymap import BANNER, STOP, Teleop, TeleopConfig, format_status
-from diffbot_sim.control.kinematics import yaw_from_quaternion
 from diffbot_sim.teleop.terminal import EOF, StatusLine, raw_terminal, read_key, require_tty
 
 NODE_NAME = "teleop_key"

@@ -24,9 +24,8 @@ import sys
 import time
 
 from diffbot_sim import streams
-
-from diffbot_sim.view import rviz_config
 from diffbot_sim.errors import DiffbotSimError
+from diffbot_sim.view import rviz_config
 
 TEMPLATE = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(
     os.path.realpath(__file__))))), "rviz", "diffbot.rviz")
@@ -92,8 +91,8 @@ def robot_views(master, sim, timeout):
 
 def world_bounds(sim):
     """The world's static geometry extent in the world frame, or None without a world."""
-    from diffbot_sim.world.markers import bounds_xy, marker_specs
     from diffbot_sim.nodes.world_markers import _read_world
+    from diffbot_sim.world.markers import bounds_xy, marker_specs
 
     world = _read_world(sim)
     return bounds_xy(marker_specs(world)) if world is not None else None

@@ -2,6 +2,7 @@
 import contextlib
 import os
 
+
 @contextlib.contextmanager
 def quiet(fd):
     """Silence a file descriptor: PyBullet's C code prints a build banner on import (stderr) and

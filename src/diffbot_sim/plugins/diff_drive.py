@@ -15,11 +15,11 @@ from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 
 from diffbot_sim import config as cfgmod
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.control.gazebo_diff_drive import DiffDriveController
 from diffbot_sim.control.kinematics import quaternion_from_yaw
 from diffbot_sim.control.odometry import EncoderOdometry
 from diffbot_sim.plugins.base import Plugin, finite_twist, join, next_due
+from diffbot_sim.ros import messages as ros_msgs
 
 
 class DiffDrive(Plugin):

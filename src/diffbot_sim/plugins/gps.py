@@ -22,13 +22,12 @@ import math
 from geometry_msgs.msg import Vector3Stamped
 from sensor_msgs.msg import NavSatFix
 
-from diffbot_sim.sensors import noise
-
-from diffbot_sim.ros import messages as ros_msgs
-from diffbot_sim.errors import ModelError, PluginNotLoaded
-from diffbot_sim.values import check_bool, tag_number
-from diffbot_sim.plugins.base import Plugin, join, summary_key
 from diffbot_sim.description.plugin_tags import read_tags
+from diffbot_sim.errors import ModelError, PluginNotLoaded
+from diffbot_sim.plugins.base import Plugin, join, summary_key
+from diffbot_sim.ros import messages as ros_msgs
+from diffbot_sim.sensors import noise
+from diffbot_sim.values import check_bool, tag_number
 
 FILENAME = "libhector_gazebo_ros_gps.so"
 #: WGS84 ellipsoid.

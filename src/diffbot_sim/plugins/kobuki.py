@@ -23,13 +23,13 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import Empty
 
-from diffbot_sim.ros import messages as ros_msgs
-from diffbot_sim.errors import ModelError
 from diffbot_sim.control.kinematics import quaternion_from_yaw, wheel_speeds
 from diffbot_sim.description.urdf_model import tag_value
-from diffbot_sim.values import check_bool, check_string, tag_number
+from diffbot_sim.errors import ModelError
 from diffbot_sim.plugins.base import Plugin, finite_twist, join
 from diffbot_sim.plugins.joint_motors import UNLIMITED_EFFORT
+from diffbot_sim.ros import messages as ros_msgs
+from diffbot_sim.values import check_bool, check_string, tag_number
 
 REQUIRED = ("left_wheel_joint_name", "right_wheel_joint_name", "wheel_separation", "wheel_diameter",
             "torque", "velocity_command_timeout")

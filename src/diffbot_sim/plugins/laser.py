@@ -22,13 +22,12 @@ casting is ``World.ray_batch``. As gazebo_ros does:
 """
 from sensor_msgs.msg import LaserScan, PointCloud, PointCloud2, Range
 
-from diffbot_sim.sensors import ray as ray_sensor
-
-from diffbot_sim.ros import messages as ros_msgs
-from diffbot_sim.errors import ConfigError
 from diffbot_sim.description.urdf_model import tag_value
-from diffbot_sim.values import check_string, tag_number
+from diffbot_sim.errors import ConfigError
 from diffbot_sim.plugins.base import Plugin, join, summary_key
+from diffbot_sim.ros import messages as ros_msgs
+from diffbot_sim.sensors import ray as ray_sensor
+from diffbot_sim.values import check_string, tag_number
 
 ROS1_LASERS = ("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so")
 ROS2_RAY = "libgazebo_ros_ray_sensor.so"

@@ -11,10 +11,10 @@ import threading
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.description.urdf_model import tag_value
-from diffbot_sim.values import check_bool, check_string, tag_number
 from diffbot_sim.plugins.base import Plugin, finite_twist, join
+from diffbot_sim.ros import messages as ros_msgs
+from diffbot_sim.values import check_bool, check_string, tag_number
 
 DEFAULTS = {"commandTopic": "cmd_vel", "odometryTopic": "odom", "odometryFrame": "odom",
             "robotBaseFrame": "base_footprint", "odometryRate": 20.0, "publishOdometryTf": True,

@@ -13,12 +13,18 @@ warning; gazebo_ros says ``/world``); ``radiation`` (``ultrasound``, anything el
 """
 from sensor_msgs.msg import Range as RangeMsg
 
-from diffbot_sim.sensors import ray as ray_sensor
-
-from diffbot_sim.ros import messages as ros_msgs
-from diffbot_sim.values import check_string, tag_number
 from diffbot_sim.plugins.base import join
-from diffbot_sim.plugins.laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
+from diffbot_sim.plugins.laser import (
+    RaySensorPlugin,
+    _check_type,
+    _plugin_path,
+    plugin_tags,
+    ros1_frame,
+    ros1_namespace,
+)
+from diffbot_sim.ros import messages as ros_msgs
+from diffbot_sim.sensors import ray as ray_sensor
+from diffbot_sim.values import check_string, tag_number
 
 _READ = ("robotNamespace", "topicName", "frameName", "radiation", "fov", "gaussianNoise", "updateRate")
 

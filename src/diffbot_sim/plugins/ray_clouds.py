@@ -14,12 +14,19 @@ sensor_msgs/PointCloud2 with x, y, z, intensity, ring, time). Casting and range 
   ``min_intensity`` (0). ``ring`` is the vertical row, 0 the lowest.
 """
 import numpy as np
+from sensor_msgs.msg import PointCloud, PointCloud2
 
+from diffbot_sim.plugins.base import join
+from diffbot_sim.plugins.laser import (
+    RaySensorPlugin,
+    _check_type,
+    _plugin_path,
+    plugin_tags,
+    ros1_frame,
+    ros1_namespace,
+)
 from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.values import check_bool, tag_number
-from diffbot_sim.plugins.base import join
-from diffbot_sim.plugins.laser import RaySensorPlugin, _check_type, _plugin_path, plugin_tags, ros1_frame, ros1_namespace
-from sensor_msgs.msg import PointCloud, PointCloud2
 
 BLOCK = "libgazebo_ros_block_laser.so"
 VELODYNE = ("libgazebo_ros_velodyne_laser.so", "libgazebo_ros_velodyne_gpu_laser.so")

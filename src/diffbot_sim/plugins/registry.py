@@ -3,15 +3,26 @@
 The two plugins the model reader parses itself (diff drive, joint-state publisher) are built from their
 PluginBlocks; every other one from its element by its module's ``create(ctx, element, path, params)``.
 """
-from diffbot_sim.plugins import diff_drive, gps, imu, joint_state, kobuki, p3d, planar_move, ray_clouds, ros_control, skid_steer
+from diffbot_sim.description.plugin_tags import DIFF_DRIVE, JOINT_STATE, plugin_filename
+from diffbot_sim.errors import PluginNotLoaded
+from diffbot_sim.plugins import (
+    diff_drive,
+    gps,
+    imu,
+    joint_state,
+    kobuki,
+    p3d,
+    planar_move,
+    ray_clouds,
+    ros_control,
+    skid_steer,
+)
 from diffbot_sim.plugins.camera import create as create_camera
 from diffbot_sim.plugins.depth import create as create_depth
 from diffbot_sim.plugins.ground_truth import GroundTruth
 from diffbot_sim.plugins.joint_motors import JointMotors
 from diffbot_sim.plugins.laser import create_laser, create_ray_sensor
 from diffbot_sim.plugins.range import create as create_range
-from diffbot_sim.errors import PluginNotLoaded
-from diffbot_sim.description.plugin_tags import DIFF_DRIVE, JOINT_STATE, plugin_filename
 
 #: Model plugins by filename (``libNAME.so``).
 MODEL_PLUGINS = {

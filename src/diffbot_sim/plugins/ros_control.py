@@ -7,9 +7,9 @@ in Debian, so this plugin plays both parts: it finds every controller under the 
 plugin's ``robotNamespace``, else the spawner's ``/``; if none is there, anywhere on the parameter server)
 and starts the ones it knows:
 
-* ``diff_drive_controller/DiffDriveController`` (:mod:`diffbot_sim.control.diff_drive_controller`): ``<controller>/cmd_vel`` in,
-  ``<controller>/odom`` out, ``/tf`` when ``enable_odom_tf``, ``<controller>/cmd_vel_out`` when
-  ``publish_cmd``; geometry from the URDF where the YAML gives none (first left/right joint origins, the
+* ``diff_drive_controller/DiffDriveController`` (:mod:`diffbot_sim.control.diff_drive_controller`):
+  ``<controller>/cmd_vel`` in, ``<controller>/odom`` out, ``/tf`` when ``enable_odom_tf``,
+  ``<controller>/cmd_vel_out`` when ``publish_cmd``; geometry from the URDF where the YAML gives none (first left/right joint origins, the
   first left wheel's cylinder or sphere collision);
 * ``joint_state_controller/JointStateController``: ``joint_states`` in the controller manager's namespace,
   every transmission joint plus ``extra_joints``, at ``publish_rate``;
@@ -33,18 +33,15 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Bool, Float64
 
 from diffbot_sim.control import controller_lookup as controllers
-
-from diffbot_sim.control import diff_drive_controller as ddc
-
-from diffbot_sim.ros import messages as ros_msgs
-
 from diffbot_sim.control import controller_switching as switching
-from diffbot_sim.errors import ConfigError, ModelError
+from diffbot_sim.control import diff_drive_controller as ddc
 from diffbot_sim.control.kinematics import quaternion_from_yaw
 from diffbot_sim.description.urdf_model import tag_value
-from diffbot_sim.values import check_number, check_string, tag_number
+from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.plugins.base import Plugin, get_param, join, next_due
 from diffbot_sim.plugins.joint_motors import effort_limit
+from diffbot_sim.ros import messages as ros_msgs
+from diffbot_sim.values import check_number, check_string, tag_number
 
 #: Controller update period [s] when the plugin gives no ``controlPeriod``. Gazebo runs controllers at
 #: every physics step (1 kHz in its default world); 100 Hz keeps real-time CPU low, and with velocity motors
@@ -236,7 +233,8 @@ class RosControl(Plugin):
         return [name for name, runner in self.loaded.items() if runner in self.controllers]
 
     def switch(self, start, stop, strictness):
-        """SwitchController: stop, then start (controller_manager's rules, :mod:`diffbot_sim.control.controller_switching`)."""
+        """SwitchController: stop, then start (controller_manager's rules,
+        :mod:`diffbot_sim.control.controller_switching`)."""
         claims = {n: r.joints() for n, r in self.loaded.items()}
         to_stop, to_start = switching.plan_switch(self.loaded, self._running(), claims, start, stop, strictness)
         for name in to_stop:

@@ -12,12 +12,22 @@ purpose: genpy reads ``self.__slots__`` for the field list (printing, equality, 
 import struct
 
 import numpy as np
-
 from geometry_msgs.msg import Point32, TransformStamped, Twist, TwistStamped, Vector3Stamped
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import (CameraInfo, ChannelFloat32, Image, Imu, JointState, LaserScan, NavSatFix, PointCloud,
-                             PointCloud2, PointField, Range)
+from sensor_msgs.msg import (
+    CameraInfo,
+    ChannelFloat32,
+    Image,
+    Imu,
+    JointState,
+    LaserScan,
+    NavSatFix,
+    PointCloud,
+    PointCloud2,
+    PointField,
+    Range,
+)
 from tf2_msgs.msg import TFMessage
 
 _HEADER = struct.Struct("<3I")  # seq, stamp.secs, stamp.nsecs

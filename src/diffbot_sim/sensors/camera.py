@@ -21,8 +21,8 @@ from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
-from diffbot_sim.errors import ConfigError
 from diffbot_sim.description.urdf_model import tag_value
+from diffbot_sim.errors import ConfigError
 from diffbot_sim.values import check_number, tag_number
 
 CAMERA_TYPES = ("camera", "depth")

@@ -22,10 +22,10 @@ from typing import List, Tuple
 
 import numpy as np
 
-from diffbot_sim.errors import ConfigError
-from diffbot_sim.values import check_bool, check_number, tag_number
 from diffbot_sim.description.urdf_model import tag_value
+from diffbot_sim.errors import ConfigError
 from diffbot_sim.transforms import rpy_matrix
+from diffbot_sim.values import check_bool, check_number, tag_number
 
 
 @dataclass

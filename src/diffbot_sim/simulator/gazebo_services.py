@@ -24,10 +24,9 @@ from std_msgs.msg import Header
 from std_srvs.srv import Empty
 
 from diffbot_sim.description import meshes
-
-from diffbot_sim.gazebo import model_xml, world_api
 from diffbot_sim.description.model_files import package_path
 from diffbot_sim.errors import DiffbotSimError
+from diffbot_sim.gazebo import model_xml, world_api
 from diffbot_sim.plugins.base import close_handle, publisher
 from diffbot_sim.transforms import compose, inverse
 

@@ -8,14 +8,13 @@ import rospy
 from diffbot_sim import config as cfgmod
 from diffbot_sim.description import meshes
 from diffbot_sim.description.model_files import load_file, package_path, parse_args
-from diffbot_sim.world.loading import load_world
-from diffbot_sim.errors import ModelError
-from diffbot_sim.description.urdf_model import parse_urdf, tag_value
 from diffbot_sim.description.plugin_tags import read_plugins
+from diffbot_sim.description.urdf_model import parse_urdf, tag_value
+from diffbot_sim.errors import ModelError
 from diffbot_sim.plugins import registry
 from diffbot_sim.plugins.base import RobotContext, get_param
-
 from diffbot_sim.simulator.loop import RobotRuntime, Simulator
+from diffbot_sim.world.loading import load_world
 
 
 def _load_model(spec):

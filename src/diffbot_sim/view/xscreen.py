@@ -176,8 +176,9 @@ def find_window(display, pattern):
 
 def screenshot(display, window="root"):
     """The screen (or one window, by id) as an (H, W, 3) uint8 RGB array, through ImageMagick's import."""
-    from PIL import Image
     import io
+
+    from PIL import Image
 
     out = subprocess.run(["import", "-display", display, "-window", window, "png:-"], capture_output=True,
                          timeout=30)

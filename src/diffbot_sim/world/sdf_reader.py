@@ -32,10 +32,10 @@ import os
 import xml.etree.ElementTree as ET
 
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.values import tag_number
 from diffbot_sim.transforms import compose, inverse, qnormalize, rpy_quaternion
-from diffbot_sim.world.model_paths import env_model_paths
+from diffbot_sim.values import tag_number
 from diffbot_sim.world.bodies import IDENTITY, Body, Shape, WorldDescription
+from diffbot_sim.world.model_paths import env_model_paths
 
 #: The SDF versions this reader knows; others are read as the nearest one (with a warning).
 VERSIONS = ((1, 4), (1, 5), (1, 6), (1, 7), (1, 8), (1, 9))

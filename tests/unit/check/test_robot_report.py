@@ -5,11 +5,9 @@ import os
 import pytest
 import yaml
 
-from diffbot_sim.plugins.registry import KNOWN, KNOWN_SENSORS
-from diffbot_sim.check import drive_check
-
-from diffbot_sim.check import robot_report
+from diffbot_sim.check import drive_check, robot_report
 from diffbot_sim.errors import ConfigError, ModelError
+from diffbot_sim.plugins.registry import KNOWN, KNOWN_SENSORS
 
 ROBOTS = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "data", "robots")
 

@@ -2,7 +2,14 @@
 controller_manager command rely on)."""
 import pytest
 
-from diffbot_sim.control.controller_switching import (BEST_EFFORT, STRICT, SwitchError, check_load, check_unload, plan_switch)
+from diffbot_sim.control.controller_switching import (
+    BEST_EFFORT,
+    STRICT,
+    SwitchError,
+    check_load,
+    check_unload,
+    plan_switch,
+)
 
 CLAIMS = {"base": {"l", "r"}, "jsc": set(), "left_only": {"l"}, "arm": {"a"}}
 

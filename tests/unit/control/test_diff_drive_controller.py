@@ -8,7 +8,13 @@ import math
 
 import pytest
 
-from diffbot_sim.control.diff_drive_controller import CONTROLLER_TYPE, DdcConfig, DdcStep, DiffDriveControllerCore, ddc_config
+from diffbot_sim.control.diff_drive_controller import (
+    CONTROLLER_TYPE,
+    DdcConfig,
+    DdcStep,
+    DiffDriveControllerCore,
+    ddc_config,
+)
 from diffbot_sim.errors import ConfigError
 
 NS = "/diffbot_controller"

@@ -3,8 +3,8 @@ import math
 
 import pytest
 
-from diffbot_sim.errors import ConfigError
 from diffbot_sim.control.odometry import EncoderOdometry, integrate_exact
+from diffbot_sim.errors import ConfigError
 
 R, S = 0.032, 0.2  # the seed's wheel radius and separation
 

@@ -10,10 +10,7 @@ import pybullet
 import pytest
 
 from diffbot_sim import physics
-
-from diffbot_sim.description import lumping
-
-from diffbot_sim.description import meshes
+from diffbot_sim.description import lumping, meshes
 from diffbot_sim.description.model_files import load_file
 from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.physics import World

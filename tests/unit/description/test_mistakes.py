@@ -7,14 +7,13 @@ import pybullet
 import pytest
 
 from diffbot_sim import config
-
 from diffbot_sim.description import mesh_formats, meshes
 from diffbot_sim.description.model_files import load_file
+from diffbot_sim.description.plugin_tags import read_plugins
 from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.physics import World
 from diffbot_sim.plugins import registry
 from diffbot_sim.plugins.base import RobotContext
-from diffbot_sim.description.plugin_tags import read_plugins
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 MISTAKES = os.path.join(ROOT, "tests", "data", "robots", "mistakes.urdf")

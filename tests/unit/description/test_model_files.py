@@ -4,8 +4,8 @@ import os
 import pytest
 
 from diffbot_sim.description.model_files import load_file, parse_args
-from diffbot_sim.errors import ModelError
 from diffbot_sim.description.urdf_model import parse_urdf
+from diffbot_sim.errors import ModelError
 
 
 @pytest.fixture

@@ -3,15 +3,16 @@ import os
 
 import pytest
 
-from diffbot_sim.errors import ModelError
 from diffbot_sim.description.plugin_tags import read_plugins
+from diffbot_sim.errors import ModelError
 
 
 def _gazebo(*plugins):
     return "\n  <gazebo>" + "".join(plugins) + "</gazebo>"
 
 
-with open(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "ros1_diff_drive.xml")) as _f:
+DATA = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data")
+with open(os.path.join(DATA, "ros1_diff_drive.xml")) as _f:
     ROS1_DIFF_DRIVE = _f.read()
 
 

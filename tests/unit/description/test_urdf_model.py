@@ -4,9 +4,8 @@ import math
 
 import pytest
 
-from diffbot_sim.errors import ModelError
 from diffbot_sim.description.urdf_model import Transmission, parse_urdf
-
+from diffbot_sim.errors import ModelError
 
 # ------------------------------------------------------------------------------------------ the seed robot
 

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from diffbot_sim.sensors import camera as cam
 from diffbot_sim.physics import World
+from diffbot_sim.sensors import camera as cam
 from diffbot_sim.world.bodies import Body, Shape, WorldDescription
 
 W, H, HFOV, NEAR, FAR = 320, 240, 1.047, 0.1, 10.0

@@ -9,10 +9,10 @@ import pytest
 
 from diffbot_sim import physics
 from diffbot_sim.control.gazebo_diff_drive import DiffDriveController
-from diffbot_sim.description.urdf_model import parse_urdf
-from diffbot_sim.control.odometry import EncoderOdometry
 from diffbot_sim.control.kinematics import yaw_from_quaternion
+from diffbot_sim.control.odometry import EncoderOdometry
 from diffbot_sim.description import lumping
+from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.physics import World
 
 DT = 1.0 / 240.0

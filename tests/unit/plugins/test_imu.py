@@ -5,12 +5,12 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.description.urdf_model import parse_urdf
-from diffbot_sim.physics import World
 from diffbot_sim import transforms
-from diffbot_sim.plugins import gps, imu, p3d
 from diffbot_sim.description.plugin_tags import SensorElement
+from diffbot_sim.description.urdf_model import parse_urdf
+from diffbot_sim.errors import ConfigError, ModelError
+from diffbot_sim.physics import World
+from diffbot_sim.plugins import gps, imu, p3d
 
 PATH = "/robot/gazebo[@reference='imu_link']/sensor[@name='imu']"
 

@@ -5,8 +5,8 @@ import math
 import pytest
 
 from diffbot_sim import config
-from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.description.urdf_model import tag_value
+from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.plugins import ros_control
 from diffbot_sim.plugins.ros_control import Pid
 

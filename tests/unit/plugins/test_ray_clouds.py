@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 
 from diffbot_sim.config import sim_config
+from diffbot_sim.description.plugin_tags import SensorElement
 from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.physics import World
 from diffbot_sim.plugins import base, ray_clouds
 from diffbot_sim.plugins.base import RobotContext
-from diffbot_sim.description.plugin_tags import SensorElement
 from diffbot_sim.world.bodies import Body, Shape, WorldDescription
 
 LASER_URDF = os.path.join(os.path.dirname(__file__), "..", "..", "data", "robots", "laser_robot.urdf")

@@ -126,8 +126,7 @@ def test_generated_class_has_noetic_md5(full_type):
 @pytest.mark.parametrize("full_type", sorted(NOETIC_MD5))
 def test_overlay_source_has_noetic_md5(full_type):
     """The .msg/.srv text itself (not the build) hashes to noetic's md5: catches an edit not yet rebuilt."""
-    from genmsg import MsgContext, compute_md5
-    from genmsg import msg_loader
+    from genmsg import MsgContext, compute_md5, msg_loader
 
     search = dict(DEPENDENCY_MSG_DIRS)
     for pkg in PACKAGES:

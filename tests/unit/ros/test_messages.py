@@ -2,10 +2,10 @@
 import io
 
 import genpy
+from geometry_msgs.msg import TransformStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
-from geometry_msgs.msg import TransformStamped
 
 from diffbot_sim.ros import messages as ros_msgs
 

@@ -7,8 +7,8 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from diffbot_sim.sensors import camera as cam
 from diffbot_sim.errors import ConfigError
+from diffbot_sim.sensors import camera as cam
 
 PATH = "/robot/gazebo[@reference='camera_link']/sensor[@name='c']"
 

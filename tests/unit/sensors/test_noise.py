@@ -5,8 +5,8 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from diffbot_sim.sensors import noise
 from diffbot_sim.errors import ModelError
+from diffbot_sim.sensors import noise
 
 
 def samples(model, n=20000, value=0.0):

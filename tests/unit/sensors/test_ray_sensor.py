@@ -7,8 +7,8 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from diffbot_sim.sensors import ray as rs
 from diffbot_sim.errors import ConfigError
+from diffbot_sim.sensors import ray as rs
 
 HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LASER_URDF = os.path.join(os.path.dirname(HERE), "data", "robots", "laser_robot.urdf")
@@ -390,9 +390,8 @@ class _Ctx:
     """Enough of plugins.base.RobotContext for building sensor plugins."""
 
     def __init__(self, model, namespace=None, params=None):
-        from diffbot_sim.plugins.base import RobotContext
-
         from diffbot_sim.config import sim_config
+        from diffbot_sim.plugins.base import RobotContext
 
         self.model, self.namespace, self.params = model, namespace, params or {}
         self.cfg = sim_config(self.params)
@@ -407,8 +406,8 @@ class _Ctx:
 
 
 def _plugin_robot(sensor_xml):
-    from diffbot_sim.description.urdf_model import parse_urdf
     from diffbot_sim.description.plugin_tags import read_plugins
+    from diffbot_sim.description.urdf_model import parse_urdf
 
     text = ('<robot name="bot"><link name="base_link"/><link name="laser_link"/>'
             '<joint name="j" type="fixed"><parent link="base_link"/><child link="laser_link"/></joint>'
@@ -479,7 +478,8 @@ def test_ros2_ray_sensor_outputs(stub_publisher, ros, output, topic, cls):
 
 
 def test_bad_tags_raise(stub_publisher):
-    from diffbot_sim.plugins import laser, range as range_plugin
+    from diffbot_sim.plugins import laser
+    from diffbot_sim.plugins import range as range_plugin
 
     model, sensor = _plugin_robot(f'<sensor type="ray" name="lds">{RAY}<plugin name="p" '
                                   'filename="libgazebo_ros_ray_sensor.so"><output_type>sensor_msgs/Image'
@@ -529,8 +529,8 @@ def test_ros2_outputs_publish_from_the_room(room, monkeypatch, output):
     """The ROS 2 plugin on the fixture's laser link in the hand-built room: each output type is filled."""
     import genpy
 
-    from diffbot_sim.plugins import base, laser
     from diffbot_sim.description.plugin_tags import read_plugins
+    from diffbot_sim.plugins import base, laser
 
     world, robot, model = room
     monkeypatch.setattr(base, "publisher", _Listened)

@@ -1,13 +1,20 @@
 """The teleop key map: bindings with REP 103 signs, speed keys and limits, key timeout, repeat, config."""
 import math
 
-from diffbot_sim.control.kinematics import yaw_from_quaternion
-
 import pytest
 
+from diffbot_sim.control.kinematics import yaw_from_quaternion
 from diffbot_sim.errors import ConfigError
-from diffbot_sim.teleop.keymap import (MOVE_BINDINGS, QUIT_KEY, SPEED_BINDINGS, STOP, Command, Teleop, TeleopConfig,
-                                format_status)
+from diffbot_sim.teleop.keymap import (
+    MOVE_BINDINGS,
+    QUIT_KEY,
+    SPEED_BINDINGS,
+    STOP,
+    Command,
+    Teleop,
+    TeleopConfig,
+    format_status,
+)
 
 
 def make(**params):

@@ -12,8 +12,8 @@ from nav_msgs.msg import Odometry  # noqa: E402
 from sensor_msgs.msg import LaserScan  # noqa: E402
 from tf2_msgs.msg import TFMessage  # noqa: E402
 
-from diffbot_sim.view import plot_data  # noqa: E402
 from diffbot_sim.nodes import plot_run  # noqa: E402
+from diffbot_sim.view import plot_data  # noqa: E402
 
 
 def odom(t, x, y, yaw, v, w, frame="odom", child="base_footprint"):

@@ -5,11 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from diffbot_sim.view import rviz_config
-
+from diffbot_sim.view import rviz_config, xscreen
 from diffbot_sim.world import markers as world_markers
-
-from diffbot_sim.view import xscreen
 from diffbot_sim.world.bodies import Body, Shape, WorldDescription
 
 Q90 = (0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4))

@@ -7,8 +7,17 @@ import numpy as np
 import pytest
 
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.world.map_image import (MAX_BOXES_PER_BODY, REQUIRED_KEYS, MapImage, merge_rectangles, occupancy, read_map, read_pgm,
-                                   synthetic_map, walls_mesh)
+from diffbot_sim.world.map_image import (
+    MAX_BOXES_PER_BODY,
+    REQUIRED_KEYS,
+    MapImage,
+    merge_rectangles,
+    occupancy,
+    read_map,
+    read_pgm,
+    synthetic_map,
+    walls_mesh,
+)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 MAZE = os.path.join(ROOT, "worlds", "maze.yaml")
