@@ -3,7 +3,7 @@ SHELL := /bin/bash
 ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
 ENV := $(ROOT)/tools/rosenv.sh
 
-.PHONY: setup run test test-slow unit bench pictures clean
+.PHONY: setup run test test-slow test-nav unit bench pictures clean nav
 
 setup:
 	@bash $(ROOT)/tools/setup.sh
@@ -25,6 +25,16 @@ bench: setup
 # the rviz first-frame figure (tools/pictures.py; about 1 min).
 pictures: setup
 	@bash $(ENV) python3 $(ROOT)/tools/pictures.py
+
+# The ROS 1 navigation stack and gmapping, which Debian 12 does not package, built into nav_ws/ (about 5 min the
+# first time, seconds after). NAV_SOURCES=DIR takes the pinned tarballs from DIR instead of cloning.
+nav: setup
+	@NAV_SOURCES="$(NAV_SOURCES)" bash $(ROOT)/tools/nav.sh
+
+# The navigation suites (tests/integration/nav_*.test: gmapping maps judged against the worlds, move_base goals
+# judged by ground truth), at real time and in fast mode; after `make nav`. About 15 minutes.
+test-nav: setup
+	@bash $(ENV) python3 $(ROOT)/tools/run_tests.py --nav
 
 unit: setup
 	@bash $(ENV) python3 -m pytest -q $(ROOT)/tests/unit

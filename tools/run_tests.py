@@ -7,7 +7,10 @@ variables in NOT_ON_A_USERS_MACHINE), so a fault that only shows on a user's mac
 pytest (unit tests, no master) runs first; then each rostest suite in tests/integration/*.test, two at a time
 (each rostest starts its own master on a free port). rostest is judged by its exit status and its result
 XML files, never by its console output, which says OK even when a test node crashed.
-Suites whose file name starts with `slow_` run only with --slow (`make test-slow`).
+Suites whose file name starts with `slow_` run only with --slow (`make test-slow`). Suites whose name starts
+with `nav_` need the navigation stack (`make nav`) and run only with --nav (`make test-nav`): each twice, at
+real time and in fast mode (rostest arg real_time:=false), fast ones one at a time so that their figures are
+the machine's, not a neighbour's.
 """
 import argparse
 import concurrent.futures
@@ -117,8 +120,13 @@ def run_pytest(slow):
     return passed, failed, skipped, names
 
 
-def run_rostest(test_file):
+def run_rostest(test_file, mode=None):
+    """One rostest suite; ``mode`` "real_time" or "fast" (nav suites) gives it the matching real_time arg."""
     name = os.path.splitext(os.path.basename(test_file))[0]
+    args = []
+    if mode is not None:
+        args = [f"real_time:={'true' if mode == 'real_time' else 'false'}"]
+        name = f"{name}[{mode}]"
     base = os.path.join(RESULTS, "rostest", name)
     shutil.rmtree(base, ignore_errors=True)
     os.makedirs(base)
@@ -129,9 +137,10 @@ def run_rostest(test_file):
     env = user_env(ROS_HOME=os.path.join(base, "ros_home"))
     with open(log_path, "w") as log:
         try:
-            proc = subprocess.run(["rostest", "--results-base-dir", base, "diffbot_sim", os.path.basename(test_file)],
+            proc = subprocess.run(["rostest", "--results-base-dir", base, "diffbot_sim", os.path.basename(test_file)]
+                                  + args,
                                   stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, env=env,
-                                  timeout=600)
+                                  timeout=1200 if mode else 600)
             code = proc.returncode
         except subprocess.TimeoutExpired:
             code = "timeout"
@@ -162,12 +171,57 @@ def _skip_reason(name):
     return "no reason printed"
 
 
+NAV_NEEDS = ("move_base", "amcl", "map_server", "gmapping", "dwa_local_planner")
+
+
+def run_nav(args):
+    """`make test-nav`: the nav_ suites at real time (two at once: each uses a fraction of a core) and then
+    in fast mode (one at a time), after checking that `make nav` has been done."""
+    missing = [p for p in NAV_NEEDS
+               if subprocess.run(["rospack", "find", p], capture_output=True, env=user_env()).returncode != 0]
+    if missing:
+        say(f"[tests] the navigation stack is not built (rospack finds no {', '.join(missing)}): run `make nav` "
+            f"(or `make nav NAV_SOURCES=DIR` without network) first")
+        say("0 passed, 1 failed")
+        return 1
+    suites = sorted(glob.glob(os.path.join(ROOT, "tests", "integration", "nav_*.test")))
+    if args.only:
+        suites = [t for t in suites if args.only in os.path.basename(t)]
+    total_p = total_f = 0
+    failures = []
+    for mode, jobs in (("real_time", args.jobs), ("fast", 1)):
+        with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+            for name, p, f, s, n, secs in pool.map(lambda t: run_rostest(t, mode), suites):
+                say(f"[tests] rostest {name}: {p} passed, {f} failed ({secs:.0f} s)")
+                for line in _figures(name):
+                    say(f"[tests]   {line}")
+                total_p, total_f = total_p + p, total_f + f + s
+                failures += n
+    for name in failures:
+        say(f"[tests] FAILED: {name}")
+    say(f"{total_p} passed, {total_f} failed")
+    return 1 if total_f else 0
+
+
+def _figures(name):
+    """The FIGURE lines a suite's test printed (kept in its result files): its measured figures."""
+    lines = []
+    for path in sorted(glob.glob(os.path.join(RESULTS, "rostest", name, "**", "rosunit-*.xml"), recursive=True)):
+        with open(path, errors="replace") as result:
+            lines += [line.strip() for line in result if line.startswith("FIGURE ")]
+    return lines
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--slow", action="store_true", help="also run slow suites (slow_*.test, pytest -m slow)")
     parser.add_argument("--only", default=None, help="run only rostest suites whose name contains this")
+    parser.add_argument("--nav", action="store_true",
+                        help="run only the navigation suites (nav_*.test; needs `make nav`), at real time and fast")
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
+    if args.nav:
+        return run_nav(args)
     os.makedirs(RESULTS, exist_ok=True)
     total_p = total_f = total_s = 0
     failures = []
@@ -175,7 +229,8 @@ def main():
         p, f, s, n = run_pytest(args.slow)
         total_p, total_f, total_s = p, f, s
         failures += n
-    suites = sorted(glob.glob(os.path.join(ROOT, "tests", "integration", "*.test")))
+    suites = sorted(t for t in glob.glob(os.path.join(ROOT, "tests", "integration", "*.test"))
+                    if not os.path.basename(t).startswith("nav_"))
     if not args.slow:
         suites = [t for t in suites if not os.path.basename(t).startswith("slow_")]
     if args.only:

@@ -87,7 +87,7 @@ fi
 # the root itself would be a loop that roslib and rosrun walk into (each file found many times).
 PKG_LINK="$WS/src/diffbot_sim"
 mkdir -p "$PKG_LINK"
-for entry in package.xml CMakeLists.txt setup.py cmake src scripts launch urdf config tests worlds rviz; do
+for entry in package.xml CMakeLists.txt setup.py cmake src scripts launch urdf config tests worlds maps examples rviz; do
   if [ ! -L "$PKG_LINK/$entry" ]; then
     ln -sfn "../../../$entry" "$PKG_LINK/$entry"
   fi
@@ -142,8 +142,19 @@ overlay_sig() {
 }
 want_overlay="${overlay_pkgs[*]}
 $(overlay_sig)"
+# The navigation workspace `make nav` builds (nav_ws/) is this workspace's underlay when it exists: catkin then
+# chains it, and `source catkin_ws/devel/setup.bash` alone finds amcl, move_base and gmapping too. A change of
+# underlay needs a fresh configure (catkin caches the chain), so it is stamped like the overlay packages.
+NAV_SETUP="$ROOT/nav_ws/devel/setup.sh"
+UNDERLAY_STAMP="$WS/devel/.diffbot_underlay"
+underlay=""
+if [ -f "$NAV_SETUP" ] && [ -f "$ROOT/nav_ws/devel/.diffbot_built" ]; then underlay="$ROOT/nav_ws/devel"; fi
 need_build=""
 if [ ! -f "$WS/devel/setup.bash" ] || [ ! -f "$BUILD_STAMP" ]; then
+  need_build=1
+elif [ "$(cat "$UNDERLAY_STAMP" 2>/dev/null)" != "$underlay" ]; then
+  log "underlay changed (${underlay:-none}): cleaning $WS/build and $WS/devel"
+  rm -rf "$WS/build" "$WS/devel"
   need_build=1
 elif [ "$(cat "$OVERLAY_STAMP" 2>/dev/null)" != "$want_overlay" ]; then
   need_build=1
@@ -164,9 +175,12 @@ if [ -n "$need_build" ]; then
   done
   log "building $WS with catkin_make"
   t0=$SECONDS
-  (cd "$WS" && catkin_make -DPYTHON_EXECUTABLE="$VENV/bin/python" -DCATKIN_ENABLE_TESTING=ON >"$WS/catkin_make.log" 2>&1) || {
+  # shellcheck disable=SC1090
+  (set +eu; if [ -n "$underlay" ]; then . "$NAV_SETUP"; fi
+   cd "$WS" && catkin_make -DPYTHON_EXECUTABLE="$VENV/bin/python" -DCATKIN_ENABLE_TESTING=ON >"$WS/catkin_make.log" 2>&1) || {
     tail -30 "$WS/catkin_make.log"; log "catkin_make failed (log: $WS/catkin_make.log)"; exit 1; }
   touch "$BUILD_STAMP"
+  printf '%s\n' "$underlay" > "$UNDERLAY_STAMP"
   printf '%s\n' "$want_overlay" > "$OVERLAY_STAMP"
   log "built in $((SECONDS - t0)) s"
 fi

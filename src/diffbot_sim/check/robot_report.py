@@ -191,10 +191,9 @@ def build_report(path, model_args="", controller_files=(), known=(), known_senso
                     drive, notes = _ddc(model, name, params, file)
                     drives.append(drive)
                     warnings.extend(notes)
-    for gazebo in model.gazebo:
-        for el in gazebo.element.iter("sensor"):
-            name = el.get("name") or "?"
-            items.append(Item("sensor", name, el.get("type") or "?", f"{gazebo.path}/sensor[@name='{name}']", False))
+    for sensor in found.sensors:  # simulated when one of its plugins is (a bare <sensor> publishes nothing)
+        items.append(Item("sensor", sensor.name or "?", sensor.type or "?", sensor.path,
+                          any(p in known_sensors for p in sensor.plugins)))
     for blk in (found.diff_drive, found.joint_state):
         if blk is not None and blk.unknown_tags:
             warnings.append(f"{blk.path}: unknown tags ignored: {', '.join(blk.unknown_tags)}")

@@ -126,7 +126,8 @@ def test_no_drive_fixture(report):
     assert r.drive is None and r.urdf_mass == pytest.approx(1.4)
     lines = robot_report.format_report(r)
     assert any(line.startswith("drive: none found") for line in lines)
-    assert [(i.kind, i.name, i.simulated) for i in r.items] == [("sensor", "front_camera", False)]
+    # its camera has a plugin bullet_sim simulates (libgazebo_ros_camera.so); the fixed caster's bare IMU has none
+    assert [(i.kind, i.name, i.simulated) for i in r.items] == [("sensor", "front_camera", True)]
 
 
 def test_a_bad_model_names_file_and_element(report, make_urdf):

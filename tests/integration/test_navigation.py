@@ -1,0 +1,168 @@
+#!/usr/bin/env python3
+"""Navigation with the real amcl and move_base on our scans, TF and clock (navigation.launch): each goal of ~goals
+is sent to move_base's action server and must end SUCCEEDED with the body (the ground truth, not amcl's belief)
+within ~xy_tolerance m and ~yaw_tolerance rad of it. Meanwhile what these consumers rely on is recorded and
+checked: /clock strictly increasing; every TF edge published by one node only; the scan's frame in TF, its
+angles, increments and ranges consistent; no TF extrapolation complaint from amcl or move_base on /rosout.
+
+Private parameters: ~goals ([[x, y, yaw], ...] in the map frame, which is the world's), ~xy_tolerance (0.25),
+~yaw_tolerance (0.35), ~goal_timeout (sim s, 180). Figures: time to each goal, its error, sim/wall time, RTF.
+"""
+import math
+import sys
+import threading
+import time
+import unittest
+
+import actionlib
+import rospy
+import rostest
+from actionlib_msgs.msg import GoalStatus, GoalStatusArray
+from geometry_msgs.msg import PoseWithCovarianceStamped
+from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+from rosgraph_msgs.msg import Clock, Log
+from sensor_msgs.msg import LaserScan
+from tf2_msgs.msg import TFMessage
+
+from diffbot_sim.check.drive_check import wrap
+from simtest import Truth, figure, wait_for
+
+NODES = ("/amcl", "/move_base")
+
+
+class Recorder:
+    """What consumers of the simulator see, kept for checking after the goals (callbacks only store)."""
+
+    def __init__(self):
+        self.lock = threading.Lock()
+        self.clock, self.scans, self.logs = [], [], []
+        self.tf_publishers = {}  # (parent, child) -> set of caller ids
+        rospy.Subscriber("/clock", Clock, self._clock, queue_size=1000)
+        rospy.Subscriber("/tf", TFMessage, self._tf, queue_size=1000)
+        rospy.Subscriber("/scan", LaserScan, self._scan, queue_size=10)
+        rospy.Subscriber("/rosout_agg", Log, self._log, queue_size=1000)
+        self.amcl = None
+        rospy.Subscriber("/amcl_pose", PoseWithCovarianceStamped, self._amcl, queue_size=1)
+        self.status_at = time.monotonic()
+        rospy.Subscriber("/move_base/status", GoalStatusArray, self._status, queue_size=1)
+
+    def _amcl(self, msg):
+        with self.lock:
+            self.amcl = msg.pose.pose.position
+
+    def amcl_xy(self):
+        """amcl's latest belief of where the robot is (x, y), or None."""
+        with self.lock:
+            return None if self.amcl is None else (self.amcl.x, self.amcl.y)
+
+    def _status(self, _msg):
+        with self.lock:
+            self.status_at = time.monotonic()
+
+    def status_age(self):
+        """Wall seconds since move_base last published its action status (it does at 5 Hz while alive)."""
+        with self.lock:
+            return time.monotonic() - self.status_at
+
+    def _clock(self, msg):
+        with self.lock:
+            self.clock.append(msg.clock.to_sec())
+
+    def _tf(self, msg):
+        caller = msg._connection_header.get("callerid", "?")
+        with self.lock:
+            for t in msg.transforms:
+                self.tf_publishers.setdefault((t.header.frame_id.lstrip("/"), t.child_frame_id.lstrip("/")),
+                                              set()).add(caller)
+
+    def _scan(self, msg):
+        with self.lock:
+            self.scans.append(msg)
+            del self.scans[:-20]
+
+    def _log(self, msg):
+        if msg.name in NODES and msg.level >= Log.WARN:
+            with self.lock:
+                self.logs.append(f"{msg.name}: {msg.msg}")
+
+
+class NavigationTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_navigation")
+        cls.rec = Recorder()
+        cls.truth = Truth()
+        cls.client = actionlib.SimpleActionClient("move_base", MoveBaseAction)
+
+    def test_goals_are_reached_and_consumers_are_served(self):
+        if not self.client.wait_for_server(rospy.Duration(0)):
+            wait_for(lambda: self.client.wait_for_server(rospy.Duration(0.05)), 120.0, "move_base's action server")
+        wait_for(lambda: self.truth.last() is not None, 60.0, "the ground truth")
+        goals = rospy.get_param("~goals")
+        xy_tol, yaw_tol = float(rospy.get_param("~xy_tolerance", 0.25)), float(rospy.get_param("~yaw_tolerance", 0.35))
+        timeout = float(rospy.get_param("~goal_timeout", 180.0))
+        wall0, sim0 = time.monotonic(), rospy.get_time()
+        for x, y, yaw in goals:
+            goal = MoveBaseGoal()
+            goal.target_pose.header.frame_id = "map"
+            goal.target_pose.header.stamp = rospy.Time.now()
+            goal.target_pose.pose.position.x, goal.target_pose.pose.position.y = x, y
+            goal.target_pose.pose.orientation.z, goal.target_pose.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+            started, wall_started = rospy.get_time(), time.monotonic()
+            self.client.send_goal(goal)
+            # Sim time bounds the wait; a wall bound keeps a stalled simulator from hanging the suite, and a
+            # move_base that died (its status stops) ends it at once.
+            def ended():
+                self.assertLess(self.rec.status_age(), 15.0, "move_base's status stopped: did move_base die?")
+                return (self.client.get_state() not in (GoalStatus.PENDING, GoalStatus.ACTIVE)
+                        or rospy.get_time() - started > timeout)
+            self.assertTrue(wait_for(ended, timeout * 3 + 60, f"the goal ({x}, {y})"))
+            state = self.client.get_state()
+            took, wall = rospy.get_time() - started, time.monotonic() - wall_started
+            body = wait_for(lambda: (s := self.truth.last()) is not None and s.t >= rospy.get_time() - 0.2 and s,
+                            30.0, "the ground truth after the goal")
+            error, yaw_error = math.hypot(body.x - x, body.y - y), abs(wrap(body.yaw - yaw))
+            belief = self.rec.amcl_xy()
+            amcl = f", amcl's belief {math.hypot(body.x - belief[0], body.y - belief[1]) * 100:.1f} cm off the body" \
+                if belief else ""
+
+            figure(f"goal ({x}, {y}, {yaw}): {GoalStatus.to_string(state) if hasattr(GoalStatus, 'to_string') else state} "
+                   f"in {took:.1f} s sim ({wall:.1f} s wall), body {error * 100:.1f} cm and {yaw_error:.3f} rad off{amcl}")
+            self.assertEqual(state, GoalStatus.SUCCEEDED, f"goal ({x}, {y}, {yaw}) ended in state {state} after "
+                             f"{took:.1f} s")
+            self.assertLess(error, xy_tol, f"goal ({x}, {y}): the body is {error:.3f} m from it")
+            self.assertLess(yaw_error, yaw_tol, f"goal ({x}, {y}): the body's heading is {yaw_error:.3f} rad off")
+        sim_time, wall = rospy.get_time() - sim0, time.monotonic() - wall0
+        figure(f"navigation: {len(goals)} goals in {sim_time:.1f} s of sim time, {wall:.1f} s of wall time: "
+               f"RTF {sim_time / wall:.2f}")
+        self.check_consumers()
+
+    def check_consumers(self):
+        rec = self.rec
+        with rec.lock:
+            clock, scans, logs = list(rec.clock), list(rec.scans), list(rec.logs)
+            publishers = {edge: set(who) for edge, who in rec.tf_publishers.items()}
+        self.assertGreater(len(clock), 100)
+        self.assertTrue(all(b > a for a, b in zip(clock, clock[1:])), "/clock must strictly increase")
+        twice = {edge: who for edge, who in publishers.items() if len(who) > 1}
+        self.assertEqual(twice, {}, "TF edges published by more than one node")
+        children = {}
+        for parent, child in publishers:
+            children.setdefault(child, set()).add(parent)
+        self.assertEqual({c: p for c, p in children.items() if len(p) > 1}, {}, "a frame with two parents")
+        self.assertIn("odom", children.get("base_footprint", set()), publishers)
+        self.assertIn("map", children.get("odom", set()), publishers)
+        scan = scans[-1]
+        self.assertEqual(scan.header.frame_id, "base_scan")
+        self.assertAlmostEqual(scan.angle_min + scan.angle_increment * (len(scan.ranges) - 1), scan.angle_max,
+                               delta=1e-4)
+        self.assertTrue(0 < scan.range_min < scan.range_max)
+        self.assertTrue(all(scan.range_min <= r <= scan.range_max or math.isinf(r) for r in scan.ranges))
+        complaints = [line for line in logs if "xtrapolat" in line or "TF_OLD_DATA" in line]
+        self.assertEqual(complaints, [], "TF complaints of amcl or move_base")
+        figure(f"consumers: {len(clock)} /clock messages increasing, {len(publishers)} TF edges each from one node, "
+               f"{len(logs)} warnings of amcl/move_base, none about TF")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("diffbot_sim", "test_navigation", NavigationTest, sys.argv)
