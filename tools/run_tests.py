@@ -126,7 +126,7 @@ def run_rostest(test_file, mode=None):
     args = []
     if mode is not None:
         args = [f"real_time:={'true' if mode == 'real_time' else 'false'}"]
-        name = f"{name}[{mode}]"
+        name = f"{name}-{mode}"
     base = os.path.join(RESULTS, "rostest", name)
     shutil.rmtree(base, ignore_errors=True)
     os.makedirs(base)
@@ -171,6 +171,7 @@ def _skip_reason(name):
     return "no reason printed"
 
 
+NAV_FIXTURES = os.path.join(ROOT, "tests", "data", "nav_way")
 NAV_NEEDS = ("move_base", "amcl", "map_server", "gmapping", "dwa_local_planner")
 
 
@@ -184,6 +185,9 @@ def run_nav(args):
             f"(or `make nav NAV_SOURCES=DIR` without network) first")
         say("0 passed, 1 failed")
         return 1
+    # The Gazebo user's own packages (fakebot_gazebo, _slam, _navigation) that nav_gazebo_way_* launch.
+    os.environ["ROS_PACKAGE_PATH"] = os.pathsep.join(
+        [p for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p] + [NAV_FIXTURES])
     suites = sorted(glob.glob(os.path.join(ROOT, "tests", "integration", "nav_*.test")))
     if args.only:
         suites = [t for t in suites if args.only in os.path.basename(t)]

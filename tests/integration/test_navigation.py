@@ -6,7 +6,8 @@ checked: /clock strictly increasing; every TF edge published by one node only; t
 angles, increments and ranges consistent; no TF extrapolation complaint from amcl or move_base on /rosout.
 
 Private parameters: ~goals ([[x, y, yaw], ...] in the map frame, which is the world's), ~xy_tolerance (0.25),
-~yaw_tolerance (0.35), ~goal_timeout (sim s, 180). Figures: time to each goal, its error, sim/wall time, RTF.
+~yaw_tolerance (0.35), ~goal_timeout (sim s, 180), ~truth_topic (the simulator's ground truth,
+/bullet_sim/ground_truth; /gazebo/<model>/ground_truth for a model spawned under the gazebo_ros drop-in), ~scan_frame (base_scan). Figures: time to each goal, its error, sim/wall time, RTF.
 """
 import math
 import sys
@@ -91,7 +92,7 @@ class NavigationTest(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("test_navigation")
         cls.rec = Recorder()
-        cls.truth = Truth()
+        cls.truth = Truth(rospy.get_param("~truth_topic", "/bullet_sim/ground_truth"))
         cls.client = actionlib.SimpleActionClient("move_base", MoveBaseAction)
 
     def test_goals_are_reached_and_consumers_are_served(self):
@@ -153,7 +154,7 @@ class NavigationTest(unittest.TestCase):
         self.assertIn("odom", children.get("base_footprint", set()), publishers)
         self.assertIn("map", children.get("odom", set()), publishers)
         scan = scans[-1]
-        self.assertEqual(scan.header.frame_id, "base_scan")
+        self.assertEqual(scan.header.frame_id, rospy.get_param("~scan_frame", "base_scan"))
         self.assertAlmostEqual(scan.angle_min + scan.angle_increment * (len(scan.ranges) - 1), scan.angle_max,
                                delta=1e-4)
         self.assertTrue(0 < scan.range_min < scan.range_max)

@@ -28,6 +28,8 @@ LAYERS = {
     "physics": 4, "gazebo": 4, "view": 4,
     # judging a robot (it loads it into physics); ROS messages from numbers
     "check": 5, "ros": 5,
+    # running scenario files as processes, here or on Ray (no rospy: a run's ROS processes are children)
+    "batch": 5,
     # one module per Gazebo plugin (rospy)
     "plugins": 6,
     # bullet_sim at run time (rospy)
