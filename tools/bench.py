@@ -29,6 +29,7 @@ Items (issue 10):
 import argparse
 import json
 import os
+import shutil
 import signal
 import socket
 import statistics
@@ -681,6 +682,51 @@ def bench_scale(seconds, rsp):
 
 # -------------------------------------------------------------------------------------------------- main
 
+def _batch(spec, out, jobs):
+    """Run `batch` on ``spec`` (fresh ``out``); its records and wall time."""
+    shutil.rmtree(out, ignore_errors=True)
+    t0 = time.monotonic()
+    subprocess.run([sys.executable, "-m", "diffbot_sim.nodes.batch_cli", spec, "--out", out, "--jobs", str(jobs)],
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=False)
+    wall = time.monotonic() - t0
+    with open(os.path.join(out, "results.jsonl")) as f:
+        records = [json.loads(line) for line in f]
+    return records, wall
+
+
+def bench_batch(runs):
+    """`batch`: its overhead per run (the same rostest alone vs. through batch, median of ``runs``), and the
+    drive example (examples/batch/drive.yaml, its diffbot x {empty, room} x seed 1 part) at --jobs 1 and 2:
+    runs per hour per core and the speed-up."""
+    import tempfile
+
+    tmp = tempfile.mkdtemp(prefix="bench_batch_")
+    test = os.path.join(ROOT, "tests", "rostest", "sleeper.test")
+    alone = []
+    for _ in range(runs):
+        t0 = time.monotonic()
+        subprocess.run(["rostest", "--results-base-dir", os.path.join(tmp, "alone"), test],
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True)
+        alone.append(time.monotonic() - t0)
+    spec = os.path.join(tmp, "one.yaml")
+    with open(spec, "w") as f:
+        f.write(f"scenarios:\n  - name: one\n    test: {test}\n")
+    through = [_batch(spec, os.path.join(tmp, "one"), 1)[1] for _ in range(runs)]
+    spec = os.path.join(tmp, "drive.yaml")
+    with open(spec, "w") as f:
+        f.write("scenarios:\n  - name: drive-{robot}-{world}-{seed}\n    test: diffbot_sim/tests/rostest/drive.test\n"
+                "    matrix: {robot: [diffbot, 4wd], world: [empty.world, room.world], seed: [1]}\n")
+    result = {"rostest_alone_s": statistics.median(alone), "through_batch_s": statistics.median(through)}
+    for jobs in (1, 2):
+        records, wall = _batch(spec, os.path.join(tmp, f"drive{jobs}"), jobs)
+        result[f"jobs{jobs}"] = {"wall_s": wall, "runs": len(records),
+                                 "passed": sum(r["status"] == "passed" for r in records),
+                                 "runs_per_hour_per_core": len(records) / wall * 3600 / jobs,
+                                 "median_rtf": statistics.median(r["rtf"] for r in records)}
+    shutil.rmtree(tmp, ignore_errors=True)
+    return result
+
+
 def table(r):
     rows = []
     f, n, b = r.get("fast"), r.get("fast_no_rsp"), r.get("bare")
@@ -739,6 +785,14 @@ def table(r):
         rows += [("spawn_urdf_model -> first odom of the robot (median)", f"{w['spawn_median_s']:.3f} s", "<= 0.5 s"),
                  ("set_model_state round trip p50 / p99 (real time)",
                   f"{w['set_model_state_p50_ms']:.2f} / {w['set_model_state_p99_ms']:.2f} ms", "<= 5 ms")]
+    if r.get("batch"):
+        b = r["batch"]
+        rows += [("batch: overhead per run over the same rostest alone (median)",
+                  f"{b['through_batch_s'] - b['rostest_alone_s']:.2f} s", "< 1 s"),
+                 ("batch: drive runs per hour per core, --jobs 1 / --jobs 2",
+                  f"{b['jobs1']['runs_per_hour_per_core']:.0f} / {b['jobs2']['runs_per_hour_per_core']:.0f}", ""),
+                 ("  speed-up of --jobs 2 over --jobs 1 (2 cores)",
+                  f"{b['jobs1']['wall_s'] / b['jobs2']['wall_s']:.2f}", "")]
     width = max(len(name) for name, _, _ in rows)
     lines = [f"{'measure'.ljust(width)}  {'value':>28}  target", "-" * (width + 40)]
     lines += [f"{name.ljust(width)}  {value:>28}  {target}" for name, value, target in rows]
@@ -750,7 +804,7 @@ def main():
     parser.add_argument("--probe", choices=sorted(PROBES), help=argparse.SUPPRESS)
     parser.add_argument("--options", default="{}", help=argparse.SUPPRESS)
     parser.add_argument("--only", default="fast,realtime,latency,startup,scale,meshes,ros_control,worlds,sensors,"
-                        "world_api",
+                        "world_api,batch",
                         help="comma-separated items to run (default: all)")
     parser.add_argument("--quick", action="store_true", help="shorter windows (smoke run, not for figures)")
     args = parser.parse_args()
@@ -769,7 +823,8 @@ def main():
              ("ros_control", lambda: bench_ros_control(4 if q else 12, 1 if q else 3)),
              ("worlds", lambda: bench_worlds(1 if q else 3, 4 if q else 10)),
              ("sensors", lambda: bench_sensors(1 if q else 3, 4 if q else 10, 10 if q else 30)),
-             ("world_api", lambda: bench_world_api(3 if q else 7, 100 if q else 1000))]
+             ("world_api", lambda: bench_world_api(3 if q else 7, 100 if q else 1000)),
+             ("batch", lambda: bench_batch(2 if q else 5))]
     for name, run in steps:
         wanted = name in items or (name == "scale_rsp" and "scale" in items)
         if not wanted:

@@ -129,6 +129,9 @@ class NavigationTest(unittest.TestCase):
 
             figure(f"goal ({x}, {y}, {yaw}): {GoalStatus.to_string(state) if hasattr(GoalStatus, 'to_string') else state} "
                    f"in {took:.1f} s sim ({wall:.1f} s wall), body {error * 100:.1f} cm and {yaw_error:.3f} rad off{amcl}")
+            if len(goals) == 1:  # a batch scenario's goal (tests/rostest/nav_goal.test): for results.jsonl
+                print(f"METRIC time_to_goal_s={took:.3f}\nMETRIC goal_error_m={error:.4f}\n"
+                      f"METRIC goal_yaw_error_rad={yaw_error:.4f}", flush=True)
             self.assertEqual(state, GoalStatus.SUCCEEDED, f"goal ({x}, {y}, {yaw}) ended in state {state} after "
                              f"{took:.1f} s")
             self.assertLess(error, xy_tol, f"goal ({x}, {y}): the body is {error:.3f} m from it")

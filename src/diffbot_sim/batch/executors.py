@@ -111,6 +111,12 @@ def _on_every_node(ray, marker):
 
 def run_ray(runs, out_dir, batch_id, address, on_record, say):
     """``address`` None: start a Ray instance on this machine (loopback, no dashboard) for the batch."""
+    host = (address or "127.0.0.1").rsplit(":", 1)[0].strip("[]")
+    if host in ("127.0.0.1", "localhost", "::1"):
+        # Ray turns a loopback address into this machine's outward IP before connecting (for clusters that
+        # span machines); a cluster bound to loopback is reached only if Ray keeps to loopback. Its switch for
+        # that (read when ray is imported, so set first):
+        os.environ.setdefault("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER", "0")
     import ray
     from ray.exceptions import GetTimeoutError, NodeDiedError, RayTaskError, WorkerCrashedError
     from ray.util.scheduling_strategies import NodeAffinitySchedulingStrategy

@@ -96,7 +96,7 @@ def summary(records, wall_s, slowest=5):
         f"wall time {wall_s:.1f} s (this invocation); runs' own wall time {sum(r['wall_s'] for r in records):.1f} s",
         f"median RTF {statistics.median(rtfs):.2f}" if rtfs else "median RTF -  (no run reported sim time)",
         "",
-        f"slowest runs:",
+        "slowest runs:",
         f"  {'run':<40} {'status':<8} {'wall s':>8} {'sim s':>8} {'RTF':>6}  node",
     ]
     for r in sorted(records, key=lambda r: -r["wall_s"])[:slowest]:
