@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """The batch runner's test subject (sleeper.test): ~outcome pass, fail, crash (exits 3 without a result) or
-hang (never ends; a child in a process group of its own hangs too). ~seconds of /clock-free sleeping first.
-It publishes nothing on /clock, so its runs report no sim time."""
+hang (never ends; a child in a process group of its own hangs too) or lose_worker (on a run's first attempt
+under Ray, SIGKILLs the Ray worker running it, as a machine lost mid-run would; passes on the retry).
+~seconds of /clock-free sleeping first. It publishes nothing on /clock, so its runs report no sim time."""
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -10,6 +12,18 @@ import unittest
 
 import rospy
 import rostest
+
+
+def ray_worker_above():
+    """Pid of the Ray worker process this process descends from (its title starts with 'ray::')."""
+    pid = os.getppid()
+    while pid > 1:
+        with open(f"/proc/{pid}/cmdline", "rb") as f:
+            if f.read().startswith(b"ray::"):
+                return pid
+        with open(f"/proc/{pid}/stat") as f:
+            pid = int(f.read().rsplit(")", 1)[1].split()[1])
+    raise AssertionError("not run by a Ray worker")
 
 
 class Sleeper(unittest.TestCase):
@@ -21,6 +35,9 @@ class Sleeper(unittest.TestCase):
             self.fail("told to fail")
         if outcome == "crash":
             os._exit(3)
+        if outcome == "lose_worker" and os.environ.get("DIFFBOT_BATCH_RUN", "").endswith("/1"):
+            os.kill(ray_worker_above(), signal.SIGKILL)
+            time.sleep(3600)  # ended by the runner's clean-up of the lost attempt
         if outcome == "hang":
             subprocess.Popen(["sleep", "3600"], start_new_session=True)
             time.sleep(3600)

@@ -1,14 +1,16 @@
 """`batch` for real: a local batch of real scenario runs (our robots driving, judged by ground truth) beside
 runs that fail, hang past their timeout, or are stopped by Ctrl-C; and the same runner on a two-node Ray
 cluster started on this machine (Ray's own test-cluster helper: a head and a worker node, loopback, no
-dashboard), whose results must show runs on both nodes. Every run's processes must be gone after."""
+dashboard), whose results must show runs on both nodes, and a run whose Ray worker is killed mid-run run
+again on the other node and recorded once. Every run's processes must be gone after."""
+import glob
 import json
 import os
 import signal
 import subprocess
+import tempfile
 import time
 
-import pytest
 from proctools import SETUP
 
 MARKER = b"DIFFBOT_BATCH_RUN="
@@ -136,10 +138,11 @@ scenarios:
     assert batch_processes() == []
 
 
-def test_two_node_ray_cluster_runs_on_both_nodes(tmp_path):
-    pytest.importorskip("ray")
+def test_two_node_ray_cluster_runs_on_both_nodes(tmp_path, monkeypatch):
+    monkeypatch.setenv("RAY_USAGE_STATS_ENABLED", "0")
     from ray.cluster_utils import Cluster
 
+    work_before = set(glob.glob(os.path.join(tempfile.gettempdir(), "diffbot_batch_*")))
     cluster = Cluster(initialize_head=True, head_node_args={"num_cpus": 1, "include_dashboard": False,
                                                             "node_ip_address": "127.0.0.1"})
     try:
@@ -147,16 +150,24 @@ def test_two_node_ray_cluster_runs_on_both_nodes(tmp_path):
         cluster.wait_for_nodes()
         spec = tmp_path / "s.yaml"
         spec.write_text(f"scenarios:\n  - name: run-{{k}}\n    test: {SLEEPER}\n"
-                        f"    args: {{seconds: 3}}\n    matrix: {{k: [1, 2, 3, 4]}}\n")
+                        f"    args: {{seconds: 3}}\n    matrix: {{k: [1, 2, 3, 4]}}\n"
+                        f"  - name: loses-its-worker\n    test: {SLEEPER}\n    args: {{outcome: lose_worker}}\n")
         out = str(tmp_path / "out")
         proc = batch([str(spec), "--out", out, "--ray", cluster.address])
         _, stderr = proc.communicate(timeout=300)
         assert proc.returncode == 0, stderr
         got = records(out)
-        assert sorted(got) == ["run-1", "run-2", "run-3", "run-4"]
+        lines = open(os.path.join(out, "results.jsonl")).read().splitlines()
+        assert sorted(got) == ["loses-its-worker", "run-1", "run-2", "run-3", "run-4"] and len(lines) == 5
         assert len({r["node"] for r in got.values()}) == 2, got  # one CPU a node: both nodes ran some
+        # A worker killed mid-run (SIGKILL, as a lost machine): the run ran again on the other node, recorded once.
+        lost = got["loses-its-worker"]
+        assert lost["status"] == "passed" and lost["attempt"] == 2, lost
+        assert lost["retried_from"] and lost["retried_from"] != lost["node"], lost
+        assert "worker or node was lost" in stderr
         for r in got.values():  # the run's folder came back to this machine
             assert r["log_dir"].startswith(out) and os.path.isfile(os.path.join(r["log_dir"], "console.log"))
     finally:
         cluster.shutdown()
-    assert batch_processes() == []
+    assert batch_processes() == []  # the lost attempt's rostest too
+    assert set(glob.glob(os.path.join(tempfile.gettempdir(), "diffbot_batch_*"))) <= work_before  # none left

@@ -10,6 +10,7 @@ knows where each run started), and recorded once. Ctrl-C cancels every task (eac
 and then ends, on every node, any process still carrying the batch's marker.
 """
 import concurrent.futures
+import glob
 import io
 import os
 import shutil
@@ -67,7 +68,7 @@ def _ray_task(run, batch_id, attempt, tracker):
 
     node_id = ray.get_runtime_context().get_node_id()
     ray.get(tracker.started.remote(run.name, node_id))
-    work = tempfile.mkdtemp(prefix=f"diffbot_batch_{batch_id}_")
+    work = tempfile.mkdtemp(prefix=_work_prefix(batch_id, run.name, attempt))
     try:
         record = run_mod.run_once(run, work, batch_id, node_id, attempt=attempt)
         return record, _pack(os.path.join(work, "runs", run.name))
@@ -75,8 +76,18 @@ def _ray_task(run, batch_id, attempt, tracker):
         shutil.rmtree(work, ignore_errors=True)
 
 
-def _cleanup_task(marker):
-    return run_mod.end_processes(marker)
+def _work_prefix(batch_id, name, attempt):
+    """Prefix of a run attempt's work folder on its node (named so that a lost attempt's folder can be found)."""
+    return f"diffbot_batch_{batch_id}_{name}_{attempt}_"
+
+
+def _cleanup_task(marker, work_prefix=None):
+    """End this node's processes carrying ``marker``; remove the work folders of a lost attempt, if named."""
+    ended = run_mod.end_processes(marker)
+    if work_prefix:
+        for folder in glob.glob(os.path.join(glob.escape(tempfile.gettempdir()), glob.escape(work_prefix) + "*")):
+            shutil.rmtree(folder, ignore_errors=True)
+    return ended
 
 
 class _Tracker:
@@ -96,12 +107,13 @@ def _alive_nodes(ray):
     return [n["NodeID"] for n in ray.nodes() if n.get("Alive")]
 
 
-def _on_every_node(ray, marker):
-    """End processes carrying ``marker`` on every live node (a task pinned to each)."""
+def _on_every_node(ray, marker, work_prefix=None):
+    """End processes carrying ``marker`` on every live node (a task pinned to each), and remove work folders
+    named ``work_prefix``."""
     from ray.util.scheduling_strategies import NodeAffinitySchedulingStrategy
 
     cleanup = ray.remote(num_cpus=0, max_retries=0)(_cleanup_task)
-    refs = [cleanup.options(scheduling_strategy=NodeAffinitySchedulingStrategy(n, soft=False)).remote(marker)
+    refs = [cleanup.options(scheduling_strategy=NodeAffinitySchedulingStrategy(n, soft=False)).remote(marker, work_prefix)
             for n in _alive_nodes(ray)]
     try:
         ray.get(refs, timeout=60)
@@ -127,6 +139,9 @@ def run_ray(runs, out_dir, batch_id, address, on_record, say):
     except ImportError:  # older Ray
         lost = (WorkerCrashedError, NodeDiedError)
     if address is None:
+        # Ray reports usage statistics to its makers unless told not to; an instance we start for a batch is not
+        # the user's to report on. (A cluster the user started follows its own `ray start` settings.)
+        os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
         ray.init(include_dashboard=False, _node_ip_address="127.0.0.1", log_to_driver=False,
                  configure_logging=False)
         say(f"[batch] started a local Ray instance on 127.0.0.1 ({int(ray.cluster_resources().get('CPU', 0))} CPUs)")
@@ -138,6 +153,7 @@ def run_ray(runs, out_dir, batch_id, address, on_record, say):
         tracker = ray.remote(num_cpus=0)(_Tracker).remote()
         task = ray.remote(max_retries=0)(_ray_task)
         pending = {}  # ObjectRef -> (run, attempt)
+        lost_on = {}  # run name -> node of its lost first attempt
 
         def submit(run, attempt, avoid=None):
             options = {"num_cpus": run.cpus}
@@ -158,8 +174,10 @@ def run_ray(runs, out_dir, batch_id, address, on_record, say):
                         record, blob = ray.get(ref)
                     except lost as err:
                         where = ray.get(tracker.node_of.remote(run.name))
-                        _on_every_node(ray, f"{batch_id}/{run.name}/{attempt}")
+                        _on_every_node(ray, f"{batch_id}/{run.name}/{attempt}",
+                                       _work_prefix(batch_id, run.name, attempt))
                         if attempt == 1:
+                            lost_on[run.name] = where or ""
                             say(f"[batch] {run.name}: its Ray worker or node was lost ({type(err).__name__}); "
                                 f"running it again elsewhere")
                             submit(run, 2, avoid=where)
@@ -171,6 +189,8 @@ def run_ray(runs, out_dir, batch_id, address, on_record, say):
                     if blob is not None:
                         _unpack(blob, local)
                     record["log_dir"] = local
+                    if run.name in lost_on:
+                        record["retried_from"] = lost_on[run.name]  # the node whose worker was lost
                     on_record(record)
         except KeyboardInterrupt:
             for ref in pending:
