@@ -2,9 +2,15 @@
 # Runs `make test` (and checks that `make run` brings up /odom) as a new user would: in a fresh
 # `debootstrap --variant=minbase bookworm` chroot, a clean clone of this checkout's HEAD, entered with
 # `env -i`. Needs root and the network to Debian's mirror and PyPI. ~20 min, most of it installing.
-#   sudo bash tools/clean_machine_test.sh [CHROOT_DIR]     (the directory is deleted afterwards)
+#   sudo bash tools/clean_machine_test.sh [--nav NAV_SOURCES_DIR] [CHROOT_DIR]   (the directory is deleted after)
+# --nav also runs `make nav NAV_SOURCES=...` (the pinned tarballs copied in) and `make test-nav` there
+# (about 35 min more).
 set -eo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+NAV_DIR=""
+if [ "${1:-}" = "--nav" ]; then
+  NAV_DIR="$(cd "${2:?--nav needs the folder of the navigation tarballs}" && pwd)"; shift 2
+fi
 DIR="${1:-/var/tmp/diffbot_clean_machine}"
 log() { printf '[clean-machine] %s\n' "$*"; }
 
@@ -51,10 +57,20 @@ env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/
     kill -INT -- -$run 2>/dev/null; for i in $(seq 1 50); do kill -0 $run 2>/dev/null || break; sleep 0.2; done;
     exit $r'
 run_status=$?
+nav_status=0
+if [ -n "$NAV_DIR" ]; then
+  mkdir -p "$DIR/root/nav-sources" && cp "$NAV_DIR"/*.tar.gz "$DIR/root/nav-sources/"
+  log "make nav NAV_SOURCES=/root/nav-sources, then make test-nav, in the chroot (env -i)"
+  env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin TERM=xterm LANG=C.UTF-8 \
+    chroot "$DIR" /bin/bash -lc 'cd /root/project && make nav NAV_SOURCES=/root/nav-sources && make test-nav' 2>&1 \
+    | tee "$DIR.make_test_nav.log" | grep -E '^\[|passed|failed|FIGURE'
+  nav_status=${PIPESTATUS[0]}
+  log "make nav && make test-nav exited $nav_status"
+fi
 # Whatever the chroot left running (a chroot shares the host's process table: pkill by name in it would
 # also hit the host's own ROS processes), identified by its root directory.
 for proc in /proc/[0-9]*; do
   [ "$(readlink "$proc/root" 2>/dev/null)" = "$(readlink -f "$DIR")" ] && kill -KILL "${proc#/proc/}" 2>/dev/null
 done
 set -e
-[ "$status" -eq 0 ] && [ "$run_status" -eq 0 ]
+[ "$status" -eq 0 ] && [ "$run_status" -eq 0 ] && [ "$nav_status" -eq 0 ]
