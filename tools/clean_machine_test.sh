@@ -51,7 +51,7 @@ status=${PIPESTATUS[0]}
 log "make test exited $status"
 log "make run (no terminal: simulator alone) until /odom appears"
 env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin TERM=xterm LANG=C.UTF-8 \
-  chroot "$DIR" /bin/bash -lc 'cd /root/project && setsid make run </dev/null >/tmp/run.log 2>&1 & run=$!;
+  chroot "$DIR" /bin/bash -lc 'cd /root/project; setsid make run </dev/null >/tmp/run.log 2>&1 & run=$!;
     source catkin_ws/devel/setup.bash; for i in $(seq 1 150); do rostopic list 2>/dev/null | grep -qx /odom && break; sleep 0.2; done;
     if rostopic echo -n 1 /odom/header/frame_id; then echo "make run: /odom is up"; r=0; else echo "make run: no /odom"; tail /tmp/run.log; r=1; fi;
     kill -INT -- -$run 2>/dev/null; for i in $(seq 1 50); do kill -0 $run 2>/dev/null || break; sleep 0.2; done;

@@ -11,6 +11,7 @@ import subprocess
 import tempfile
 import time
 
+import pytest
 from proctools import SETUP
 
 MARKER = b"DIFFBOT_BATCH_RUN="
@@ -171,3 +172,24 @@ def test_two_node_ray_cluster_runs_on_both_nodes(tmp_path, monkeypatch):
         cluster.shutdown()
     assert batch_processes() == []  # the lost attempt's rostest too
     assert set(glob.glob(os.path.join(tempfile.gettempdir(), "diffbot_batch_*"))) <= work_before  # none left
+
+
+@pytest.mark.slow
+def test_the_drive_example_gives_the_same_verdicts_alone_and_among_8(tmp_path):
+    """examples/batch/drive.yaml (12 runs, each judged by ground truth) one at a time and eight at once on this
+    machine: no run may disturb another (ports, log folders, mesh cache, /tmp), so every verdict is the same."""
+    example = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                           "examples", "batch", "drive.yaml")
+    verdicts = {}
+    for jobs in (1, 8):
+        out = str(tmp_path / f"jobs{jobs}")
+        proc = batch([example, "--out", out, "--jobs", str(jobs)])
+        _, stderr = proc.communicate(timeout=1800)
+        got = records(out)
+        assert len(got) == 12, stderr
+        verdicts[jobs] = {n: r["status"] for n, r in got.items()}
+        for r in got.values():
+            assert r["sim_s"] > 8.0, r
+        assert batch_processes() == []
+    assert verdicts[1] == verdicts[8]
+    assert set(verdicts[1].values()) == {"passed"}, verdicts[1]
