@@ -689,9 +689,9 @@ def _batch(spec, out, jobs):
     subprocess.run([sys.executable, "-m", "diffbot_sim.nodes.batch_cli", spec, "--out", out, "--jobs", str(jobs)],
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=False)
     wall = time.monotonic() - t0
-    with open(os.path.join(out, "results.jsonl")) as f:
-        records = [json.loads(line) for line in f]
-    return records, wall
+    from diffbot_sim.batch import results as batch_results
+
+    return list(batch_results.load(os.path.join(out, "results.jsonl")).values()), wall
 
 
 def bench_batch(runs):

@@ -15,7 +15,6 @@ the machine's, not a neighbour's; then the shipped navigation batch (examples/ba
 import argparse
 import concurrent.futures
 import glob
-import json
 import os
 import shutil
 import subprocess
@@ -225,16 +224,14 @@ def run_nav(args):
 def run_nav_batch():
     """The shipped navigation matrix (examples/batch/nav.yaml) through `batch --jobs 2`, as its README says to
     run it: each run one test; its summary table printed."""
+    from diffbot_sim.batch import results as batch_results
+
     out = os.path.join(RESULTS, "batch_nav")
     spec = os.path.join(ROOT, "examples", "batch", "nav.yaml")
     started = time.monotonic()
     proc = subprocess.run(["rosrun", "diffbot_sim", "batch", spec, "--out", out, "--jobs", "2", "--rerun"],
                           capture_output=True, text=True, env=user_env())
-    try:
-        with open(os.path.join(out, "results.jsonl")) as f:
-            records = [json.loads(line) for line in f]
-    except OSError:
-        records = []
+    records = list(batch_results.load(os.path.join(out, "results.jsonl")).values())
     passed = sum(r["status"] == "passed" for r in records)
     names = [f"batch nav.yaml: {r['name']} {r['status']}: {r.get('reason', '')} (see {r['log_dir']})"
              for r in records if r["status"] != "passed"]

@@ -9,6 +9,11 @@ import math
 import numpy as np
 
 
+def wrap_angle(angle):
+    """``angle`` in (-pi, pi]: the difference of two headings as a turn."""
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
 def rpy_matrix(rpy):
     """Rotation matrix of fixed-axis roll, pitch, yaw (URDF and SDF): Rz(yaw) @ Ry(pitch) @ Rx(roll)."""
     r, p, y = rpy

@@ -14,6 +14,12 @@ import rospy
 import rostest
 
 
+def hang_until_ended():
+    """Block until a signal ends this process (the runner's SIGTERM or SIGKILL; SIGINT only stops rospy)."""
+    while True:
+        signal.pause()
+
+
 def ray_worker_above():
     """Pid of the Ray worker process this process descends from (its title starts with 'ray::')."""
     pid = os.getppid()
@@ -37,10 +43,10 @@ class Sleeper(unittest.TestCase):
             os._exit(3)
         if outcome == "lose_worker" and os.environ.get("DIFFBOT_BATCH_RUN", "").endswith("/1"):
             os.kill(ray_worker_above(), signal.SIGKILL)
-            time.sleep(3600)  # ended by the runner's clean-up of the lost attempt
+            hang_until_ended()  # by the runner's clean-up of the lost attempt
         if outcome == "hang":
             subprocess.Popen(["sleep", "3600"], start_new_session=True)
-            time.sleep(3600)
+            hang_until_ended()
 
 
 if __name__ == "__main__":

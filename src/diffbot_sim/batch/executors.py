@@ -18,6 +18,7 @@ import socket
 import tarfile
 import tempfile
 import threading
+import time
 
 from diffbot_sim.batch import run as run_mod
 
@@ -206,7 +207,5 @@ def run_ray(runs, out_dir, batch_id, address, on_record, say):
 
 
 def _lost_record(run, attempt, node, err):
-    return {"name": run.name, "args": dict(run.args), "status": "error", "wall_s": 0.0, "sim_s": 0.0, "rtf": 0.0,
-            "node": node or "", "log_dir": "", "tests": 0, "failures": 1, "test": run.test,
-            "reason": f"Ray: {type(err).__name__}: {' '.join(str(err).split())[:300]}", "figures": [],
-            "metrics": {}, "attempt": attempt, "started": ""}
+    reason = f"Ray: {type(err).__name__}: {' '.join(str(err).split())[:300]}"
+    return run_mod.make_record(run, "error", node or "", "", time.time(), 0.0, 0.0, 0, 1, reason, [], {}, attempt)

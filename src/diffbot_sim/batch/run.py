@@ -185,7 +185,7 @@ def run_once(run: Run, out_dir, batch_id, node, stop: Optional[threading.Event] 
                 master.wait()
                 master = None
         if master is None:
-            return _record(run, "error", node, run_dir, started, time.monotonic() - wall0, 0.0, 0, 1,
+            return make_record(run, "error", node, run_dir, started, time.monotonic() - wall0, 0.0, 0, 1,
                            "could not start a rosmaster (see master.log)", [], {}, attempt)
         env = dict(base_env, ROS_MASTER_URI=f"http://127.0.0.1:{port}")
         # roscore sets /run_id (rostest --reuse-master requires it); a bare rosmaster does not.
@@ -220,10 +220,11 @@ def run_once(run: Run, out_dir, batch_id, node, stop: Optional[threading.Event] 
         return None
     sim = read_sim_time(clock_file)
     status, tests, failures, reason, figures, metrics = judge(os.path.join(run_dir, "results"), code, timed_out)
-    return _record(run, status, node, run_dir, started, wall, sim, tests, failures, reason, figures, metrics, attempt)
+    return make_record(run, status, node, run_dir, started, wall, sim, tests, failures, reason, figures, metrics, attempt)
 
 
-def _record(run, status, node, run_dir, started, wall, sim, tests, failures, reason, figures, metrics, attempt):
+def make_record(run, status, node, run_dir, started, wall, sim, tests, failures, reason, figures, metrics, attempt):
+    """A results.jsonl record (``started``: the run's start, seconds since the epoch)."""
     return {"name": run.name, "args": dict(run.args), "status": status, "wall_s": round(wall, 3),
             "sim_s": round(sim, 3), "rtf": round(sim / wall, 3) if wall > 0 else 0.0, "node": node,
             "log_dir": run_dir, "tests": tests, "failures": failures, "test": run.test, "reason": reason,

@@ -15,6 +15,8 @@ import statistics
 from dataclasses import dataclass, field
 from typing import List, NamedTuple, Optional
 
+from diffbot_sim.transforms import wrap_angle as wrap  # drive_check.wrap: callers' name for it
+
 SPEED = 0.2  # m/s, the straight run's command
 TURN = 0.5  # rad/s, the turn in place's command
 SECONDS = 4.0  # s (sim time) of each motion
@@ -64,11 +66,6 @@ def body_sample(t, position, quaternion):
     """A :class:`BodySample` from a position (x, y, z) and a quaternion (x, y, z, w)."""
     roll, pitch = roll_pitch_from_quaternion(*quaternion)
     return BodySample(t, position[0], position[1], position[2], roll, pitch, yaw_from_quaternion(*quaternion))
-
-
-def wrap(angle):
-    """``angle`` in (-pi, pi]."""
-    return math.atan2(math.sin(angle), math.cos(angle))
 
 
 def _distance(a, b):

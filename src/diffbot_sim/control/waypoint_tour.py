@@ -8,6 +8,8 @@ import math
 from dataclasses import dataclass
 from typing import List, Sequence, Tuple
 
+from diffbot_sim.transforms import wrap_angle
+
 
 @dataclass
 class TourConfig:
@@ -18,11 +20,6 @@ class TourConfig:
     tolerance: float = 0.15  # m: a waypoint is reached this close
     turn_first: float = 0.35  # rad: a heading error above this is turned away in place first
     heading_gain: float = 2.0  # 1/s: turn rate per rad of heading error
-
-
-def wrap(angle):
-    """``angle`` in (-pi, pi]."""
-    return math.atan2(math.sin(angle), math.cos(angle))
 
 
 class Tour:
@@ -48,7 +45,7 @@ class Tour:
             self.index += 1
         if self.done:
             return 0.0, 0.0
-        error = wrap(math.atan2(ty - y, tx - x) - yaw)
+        error = wrap_angle(math.atan2(ty - y, tx - x) - yaw)
         angular = max(-cfg.turn_rate, min(cfg.turn_rate, cfg.heading_gain * error))
         if abs(error) > cfg.turn_first:
             return 0.0, angular

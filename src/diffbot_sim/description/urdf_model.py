@@ -47,6 +47,25 @@ class Link:
     collisions: List[Geometry] = field(default_factory=list)
 
 
+@dataclass(frozen=True)
+class Mimic:
+    """A URDF ``<mimic joint multiplier offset>``: position = multiplier * position(joint) + offset."""
+
+    joint: str
+    multiplier: float = 1.0
+    offset: float = 0.0
+
+
+@dataclass(frozen=True)
+class SafetyController:
+    """A URDF ``<safety_controller>``: the soft limits ros_control's joint_limits_interface reads from it."""
+
+    k_velocity: float
+    k_position: float = 0.0
+    soft_lower_limit: float = 0.0
+    soft_upper_limit: float = 0.0
+
+
 @dataclass
 class Joint:
     name: str
@@ -58,10 +77,20 @@ class Joint:
     axis: Vec3 = (1.0, 0.0, 0.0)
     effort_limit: Optional[float] = None  # N·m (or N); None when the URDF gives no <limit effort>
     velocity_limit: Optional[float] = None  # rad/s (or m/s)
+    has_limit: bool = False  # the joint has a <limit> element (joint_limits_interface reads limits only then)
+    lower: float = 0.0  # rad (or m), <limit lower>; URDF's default 0
+    upper: float = 0.0  # rad (or m), <limit upper>
+    mimic: Optional[Mimic] = None
+    safety: Optional[SafetyController] = None
 
     @property
     def movable(self):
         return self.type not in ("fixed", "floating", "planar")
+
+    @property
+    def has_position_limits(self):
+        """Revolute and prismatic joints with a <limit> are bounded (continuous ones wrap around)."""
+        return self.has_limit and self.type in ("revolute", "prismatic")
 
 
 @dataclass
@@ -232,12 +261,17 @@ def parse_urdf(text, source="robot_description"):
                     default=(1.0, 0.0, 0.0))
         limit = el.find("limit")
         effort = velocity = None
+        lower = upper = 0.0
         if limit is not None:
             if limit.get("effort") is not None:
                 effort = _float(limit.get("effort"), source, f"{path}/limit[@effort]")
             if limit.get("velocity") is not None:
                 velocity = _float(limit.get("velocity"), source, f"{path}/limit[@velocity]")
-        joints[jname] = Joint(jname, jtype, parent, child, xyz, rpy, axis, effort, velocity)
+            lower = _float(limit.get("lower", "0"), source, f"{path}/limit[@lower]")
+            upper = _float(limit.get("upper", "0"), source, f"{path}/limit[@upper]")
+        joints[jname] = Joint(jname, jtype, parent, child, xyz, rpy, axis, effort, velocity, limit is not None,
+                              lower, upper, _mimic(el.find("mimic"), source, path),
+                              _safety(el.find("safety_controller"), source, path))
 
     children = {j.child for j in joints.values()}
     roots = [name for name in links if name not in children]
@@ -297,6 +331,23 @@ def _transmission(el, index, model):
         offset = _float(off_el.text, source, f"{jpath}/offset")
     return Transmission(tname or f"transmission_{index}", ttype, jname, interface,
                         actuator.get("name") if actuator is not None else None, reduction, offset)
+
+
+def _mimic(el, source, path):
+    if el is None:
+        return None
+    return Mimic(_required(el, "joint", source, f"{path}/mimic"),
+                 _float(el.get("multiplier", "1"), source, f"{path}/mimic[@multiplier]"),
+                 _float(el.get("offset", "0"), source, f"{path}/mimic[@offset]"))
+
+
+def _safety(el, source, path):
+    if el is None:
+        return None
+    where = f"{path}/safety_controller"
+    return SafetyController(_float(_required(el, "k_velocity", source, where), source, f"{where}[@k_velocity]"),
+                            *(_float(el.get(key, "0"), source, f"{where}[@{key}]")
+                              for key in ("k_position", "soft_lower_limit", "soft_upper_limit")))
 
 
 def _required(el, attr, source, path):
