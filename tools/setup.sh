@@ -31,6 +31,9 @@ DEBS=(
   libstd-msgs-dev libgeometry-msgs-dev libsensor-msgs-dev libtrajectory-msgs-dev
   ros-std-msgs ros-geometry-msgs ros-sensor-msgs ros-trajectory-msgs
   python3-trajectory-msgs
+  # overlay/control_msgs: actions (add_action_files, genaction.py, C++ headers), actionlib_msgs' .msg files,
+  # its Python classes; python3-actionlib for FollowJointTrajectory / GripperCommand action servers and clients
+  libactionlib-msgs-dev ros-actionlib-msgs python3-actionlib-msgs python3-actionlib
   # view.launch, plot_run, make pictures and the headless picture suites (view_rviz): Debian's rviz 1.14, the
   # world's markers, bags, matplotlib (Agg); Xvfb + Mesa's software OpenGL, xwininfo/xdpyinfo, ImageMagick's import
   rviz python3-visualization-msgs python3-rosbag python3-matplotlib
