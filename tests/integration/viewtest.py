@@ -178,16 +178,20 @@ class View:
         response = with_timeout(lambda: proxy(path), timeout, f"rviz's {service} {path}")
         assert response.success, f"rviz could not load {path}"
 
-    def drive(self, linear, angular, seconds):
-        """Publish a Twist at 20 Hz for ``seconds`` of sim time, then a zero one."""
-        start = rospy.get_time()
-        while rospy.get_time() - start < seconds:
-            self.alive()
-            twist = Twist()
-            twist.linear.x, twist.angular.z = linear, angular
+    def drive_until(self, linear, angular, done, timeout, what):
+        """Publish a Twist at 20 Hz (wall) until ``done()`` holds, then a zero one; AssertionError naming
+        ``what`` after ``timeout`` wall seconds. Judged by what the robot did, not by how long it was told to:
+        on a starved machine a command reaches the simulator late, and a fixed drive time moves it less."""
+        twist = Twist()
+        twist.linear.x, twist.angular.z = linear, angular
+
+        def moved():
             self.cmd.publish(twist)
-            time.sleep(0.05)
-        self.cmd.publish(Twist())
+            return done()
+        try:
+            xscreen.wait_for(lambda: self.alive() or moved(), timeout, what, period=0.05)
+        finally:
+            self.cmd.publish(Twist())
 
     # -------------------------------------------------------------------------------------- X side
 
