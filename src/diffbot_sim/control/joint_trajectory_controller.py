@@ -1,0 +1,494 @@
+"""ros_controllers' joint_trajectory_controller (0.21.2, noetic-devel 678b92a) as a pure per-update core.
+
+Arm setups made for Gazebo + gazebo_ros_control load ``{position,velocity,effort}_controllers/
+JointTrajectoryController`` from their YAML and drive it with MoveIt (``follow_joint_trajectory`` action) or
+``command`` messages. This module reproduces what the controller does with them, read from
+``joint_trajectory_controller_impl.h``, ``hardware_interface_adapter.h`` and ``tolerances.h``:
+
+- :func:`jtc_config`: ``init()``'s parameters with their defaults, checked once into :class:`JtcConfig`.
+- :class:`JointTrajectoryControllerCore`: ``starting`` (hold at the measured state), ``update`` (sample the
+  trajectory at the controller's uptime, check the active goal's path/goal tolerances, compute the
+  hardware command, decide whether ``state`` is due), ``goal`` / ``cancel`` (``goalCB`` / ``cancelCB`` with
+  control_msgs' error codes), ``command`` (the topic), ``query_state`` (the service), ``stopping``.
+
+Trajectory building and merging live in :mod:`diffbot_sim.control.trajectory`. The ROS side (messages, the
+action server and its ``action_monitor_rate`` timer, publishing) belongs to the caller, which passes sim
+time in float seconds and the joints' measured positions (rad or m) and velocities.
+
+Upstream's time base: the controller keeps an "uptime" (0 at ``starting``, + ``period`` each update). A
+message is read against the *next* update (last update's time + period), whatever the time it arrives, so
+the ``time`` arguments of ``goal``/``command``/``cancel``/``stopping`` do not move anything (kept for the
+caller's symmetry); ``query_state``'s ``time`` is the requested sample time.
+"""
+from dataclasses import dataclass
+from typing import Hashable, NamedTuple, Optional, Tuple
+
+from diffbot_sim.control.angles import shortest_angular_distance
+from diffbot_sim.control.pid import Pid, PidGains, no_p_gain_message, pid_gains
+from diffbot_sim.control.trajectory import (SegmentTolerances, StateTolerances, TrajectoryError, hold_trajectory,
+                                            joint_mapping, merge_trajectory, resolve_goal_tolerances, sample,
+                                            to_ns, to_sec)
+from diffbot_sim.errors import ConfigError, DiffbotSimError
+from diffbot_sim.values import check_bool, check_number
+
+# control_msgs/FollowJointTrajectoryResult error codes.
+SUCCESSFUL = 0
+INVALID_GOAL = -1
+INVALID_JOINTS = -2
+OLD_HEADER_TIMESTAMP = -3  # never returned by this controller (a past trajectory is INVALID_GOAL)
+PATH_TOLERANCE_VIOLATED = -4
+GOAL_TOLERANCE_VIOLATED = -5
+
+CONTROLLER_TYPES = {
+    "position_controllers/JointTrajectoryController": "position",
+    "velocity_controllers/JointTrajectoryController": "velocity",
+    "effort_controllers/JointTrajectoryController": "effort",
+    # PosVel / PosVelAcc interfaces take the desired position (and velocity / acceleration) as they are.
+    "pos_vel_controllers/JointTrajectoryController": "position",
+    "pos_vel_acc_controllers/JointTrajectoryController": "position",
+}
+
+NOT_RUNNING = "Can't accept new commands. Controller is not running."
+GOAL_NOT_RUNNING = "Can't accept new action goals. Controller is not running."
+GOAL_WRONG_JOINTS = "Joints on incoming goal don't match the controller joints."
+NO_GAINS_WARNING = "Failed to initialize PID gains from ROS parameter server."
+
+
+class ControllerCrash(DiffbotSimError):
+    """Upstream would crash the controller manager's process here (Gazebo dies); the message says why."""
+
+
+@dataclass(frozen=True)
+class JtcConfig:
+    """A JointTrajectoryController's parameters, checked, with upstream's defaults.
+
+    ``default_tolerances`` is one :class:`SegmentTolerances` per joint (``constraints/``). ``gains`` and
+    ``velocity_ff`` are read for the velocity/effort variants only. ``log`` holds ``(level, text)`` lines
+    upstream prints while loading; ``start_crash`` is set when upstream loads the controller but would crash
+    on starting it (closed-loop variant without gains for a joint).
+    """
+
+    name: str
+    controller_type: str
+    variant: str
+    joints: Tuple[str, ...]
+    wraparound: Tuple[bool, ...]
+    default_tolerances: Tuple[SegmentTolerances, ...]
+    state_publish_rate: float = 50.0
+    action_monitor_rate: float = 20.0
+    stop_trajectory_duration: float = 0.0
+    allow_partial_joints_goal: bool = False
+    gains: Tuple[PidGains, ...] = ()
+    velocity_ff: Tuple[float, ...] = ()
+    log: Tuple[Tuple[str, str], ...] = ()
+    start_crash: Optional[str] = None
+
+
+def jtc_config(params, name, joints):
+    """The :class:`JtcConfig` of the controller whose rosparam dict is ``params``.
+
+    Args:
+        params: ``rospy.get_param(name)``: ``type``, ``joints``, ``constraints``, ``gains``, ...
+        name: the controller's full namespace (e.g. ``/arm_controller``), for messages.
+        joints: the URDF's joints, name → (type, lower, upper); ``continuous`` joints wrap around.
+
+    Raises:
+        ConfigError: an unknown type, a missing/empty/non-string ``joints`` list, a joint the URDF lacks, or
+            a parameter of the wrong kind, naming the full parameter.
+    """
+    if not isinstance(params, dict):
+        raise ConfigError(name, params, "a dictionary of controller parameters")
+    controller_type = params.get("type")
+    if controller_type not in CONTROLLER_TYPES:
+        raise ConfigError(f"{name}/type", controller_type, "one of " + ", ".join(CONTROLLER_TYPES))
+    joint_names = _joint_names(params.get("joints"), f"{name}/joints", joints)
+    constraints = _sub_dict(params, "constraints", name)
+    stopped_velocity = check_number(f"{name}/constraints/stopped_velocity_tolerance",
+                                    constraints.get("stopped_velocity_tolerance", 0.01))
+    goal_time = check_number(f"{name}/constraints/goal_time", constraints.get("goal_time", 0.0))
+    tolerances = []
+    for joint in joint_names:
+        own = _sub_dict(constraints, joint, f"{name}/constraints")
+        path = check_number(f"{name}/constraints/{joint}/trajectory", own.get("trajectory", 0.0))
+        goal = check_number(f"{name}/constraints/{joint}/goal", own.get("goal", 0.0))
+        tolerances.append(SegmentTolerances(StateTolerances(position=path),
+                                            StateTolerances(position=goal, velocity=stopped_velocity), goal_time))
+    variant = CONTROLLER_TYPES[controller_type]
+    gains, velocity_ff, log, start_crash = (), (), (), None
+    if variant != "position":
+        gains, velocity_ff, log, start_crash = _closed_loop_gains(params, name, joint_names, controller_type)
+    return JtcConfig(
+        name=name, controller_type=controller_type, variant=variant, joints=joint_names,
+        wraparound=tuple(joints[joint][0] == "continuous" for joint in joint_names),
+        default_tolerances=tuple(tolerances),
+        state_publish_rate=check_number(f"{name}/state_publish_rate", params.get("state_publish_rate", 50.0),
+                                        low=0.0, low_open=True),
+        action_monitor_rate=check_number(f"{name}/action_monitor_rate", params.get("action_monitor_rate", 20.0),
+                                         low=0.0, low_open=True),
+        stop_trajectory_duration=check_number(f"{name}/stop_trajectory_duration",
+                                              params.get("stop_trajectory_duration", 0.0), low=0.0),
+        allow_partial_joints_goal=check_bool(f"{name}/allow_partial_joints_goal",
+                                             params.get("allow_partial_joints_goal", False)),
+        gains=gains, velocity_ff=velocity_ff, log=log, start_crash=start_crash)
+
+
+def _joint_names(value, label, urdf_joints):
+    expected = "a non-empty list of joint names"
+    if not isinstance(value, (list, tuple)) or not value or not all(isinstance(j, str) for j in value):
+        raise ConfigError(label, value, expected)
+    for joint in value:
+        if joint not in urdf_joints:
+            raise ConfigError(label, joint, "joints of robot_description (upstream: Could not find joint "
+                                            f"'{joint}' in URDF model.)")
+    return tuple(value)
+
+
+def _sub_dict(params, key, parent):
+    value = params.get(key)
+    if value is None:
+        return {}
+    if not isinstance(value, dict):
+        raise ConfigError(f"{parent}/{key}", value, "a dictionary")
+    return value
+
+
+def _closed_loop_gains(params, name, joint_names, controller_type):
+    """``ClosedLoopHardwareInterfaceAdapter::init``: a PID per joint from ``gains/<joint>``, then
+    ``velocity_ff/<joint>`` (default 0).
+
+    Upstream stops at the first joint without ``p`` (ROS_ERROR + ROS_WARN, ``init`` returns false), but the
+    controller ignores that result and loads. The later joints' PIDs are then null pointers, which
+    ``starting()`` dereferences, and ``velocity_ff`` is left empty, which the first ``update()`` indexes:
+    the process dies when the controller starts. That is reported in ``start_crash``.
+    """
+    all_gains = _sub_dict(params, "gains", name)
+    feed_forward = _sub_dict(params, "velocity_ff", name)
+    gains = []
+    for joint in joint_names:
+        namespace = f"{name}/gains/{joint}"
+        joint_gains = pid_gains(all_gains.get(joint), namespace)
+        if joint_gains is None:
+            log = (("error", no_p_gain_message(namespace)), ("warn", NO_GAINS_WARNING))
+            crash = (f"{name}: {controller_type} has no PID gains for joint '{joint}' ({namespace}/p); "
+                     "ros_controllers loads it anyway and crashes the controller manager's process (Gazebo) "
+                     "as soon as it starts (null PID / empty velocity_ff in HardwareInterfaceAdapter)")
+            return tuple(gains), (), log, crash
+        gains.append(joint_gains)
+    velocity_ff = tuple(check_number(f"{name}/velocity_ff/{joint}", feed_forward.get(joint, 0.0))
+                        for joint in joint_names)
+    return tuple(gains), velocity_ff, (), None
+
+
+class TrajectoryState(NamedTuple):
+    """Per-joint values as in ``control_msgs/JointTrajectoryControllerState``'s desired/actual/error.
+
+    ``actual`` and ``error`` accelerations are 0 (upstream has no measured acceleration and does not publish
+    them); ``time_from_start`` is in s.
+    """
+
+    positions: Tuple[float, ...]
+    velocities: Tuple[float, ...]
+    accelerations: Tuple[float, ...]
+    time_from_start: float
+
+
+class GoalEvent(NamedTuple):
+    """A goal that ended: ``outcome`` is "SUCCEEDED", "ABORTED" (with its code and upstream's
+    ``error_string``) or "PREEMPTED" (upstream's ``setCanceled`` of an active goal; empty result)."""
+
+    goal_id: Hashable
+    outcome: str
+    error_code: int
+    error_string: str
+
+
+class JtcUpdate(NamedTuple):
+    """One control update's result.
+
+    ``commands`` go to the joints (position variants: desired positions; velocity/effort: the PID output),
+    or None when upstream sends nothing this cycle. ``feedback_goal_id`` is the goal whose feedback
+    (desired/actual/error) upstream sets this update (published at ``action_monitor_rate``); ``state_due``
+    says whether to publish ``state`` now.
+    """
+
+    commands: Optional[Tuple[float, ...]]
+    desired: TrajectoryState
+    actual: TrajectoryState
+    error: TrajectoryState
+    events: Tuple[GoalEvent, ...]
+    state_due: bool
+    feedback_goal_id: Optional[Hashable]
+
+
+class GoalAnswer(NamedTuple):
+    """``goalCB``'s decision: accepted, or rejected with a control_msgs code and ``error_string`` (upstream
+    leaves it empty for rejections other than INVALID_GOAL from the trajectory). ``preempted_goal_id`` is the
+    previous goal, now canceled (status PREEMPTED)."""
+
+    accepted: bool
+    error_code: int
+    error_string: str
+    preempted_goal_id: Optional[Hashable] = None
+
+
+class JointTrajectoryControllerCore:
+    """One JointTrajectoryController: trajectory, active goal and command computation.
+
+    Call ``starting`` when the controller starts, ``update`` every control cycle, the other methods when
+    messages arrive. ``take_log()`` hands over the lines upstream would log (level, text).
+    """
+
+    def __init__(self, cfg: JtcConfig):
+        self.cfg = cfg
+        n = len(cfg.joints)
+        self._pids = [Pid(gains) for gains in cfg.gains] if cfg.variant != "position" else []
+        self._running = False
+        # Upstream's TimeData, in ns as ros::Time: last update's time and period, and the uptime.
+        self._time_ns = self._period_ns = self._uptime_ns = 0
+        self._trajectory = ()
+        self._active_goal = None
+        self._done = set()  # joints inside the goal tolerance; upstream's successful_joint_traj_
+        self._desired = ([0.0] * n, [0.0] * n, [0.0] * n)
+        self._measured = ([0.0] * n, [0.0] * n)
+        self._last_state_publish_ns = 0
+        self._pending = []  # goals preempted by a topic command, reported by the next update
+        self._log = list(cfg.log)
+
+    @property
+    def active_goal(self):
+        """The goal id being executed, or None."""
+        return self._active_goal
+
+    @property
+    def running(self):
+        return self._running
+
+    def take_log(self):
+        """The ``(level, text)`` lines upstream would have logged since the last call."""
+        lines, self._log = self._log, []
+        return lines
+
+    def starting(self, time, positions, velocities):
+        """Start: hold the measured state; return the adapter's first commands (measured positions, or 0).
+
+        Raises:
+            ControllerCrash: a closed-loop variant without gains (upstream crashes here or at the first update).
+        """
+        if self.cfg.start_crash:
+            raise ControllerCrash(self.cfg.start_crash)
+        self._time_ns, self._period_ns, self._uptime_ns = to_ns(time), 0, 0
+        self._measure(positions, velocities)
+        self._desired = (list(self._measured[0]), list(self._measured[1]), self._desired[2])
+        self._running = True
+        self._hold(self._uptime_ns)
+        self._last_state_publish_ns = self._uptime_ns
+        for pid in self._pids:
+            pid.reset()
+        if self.cfg.variant == "position":
+            return tuple(self._measured[0])
+        return (0.0,) * len(self.cfg.joints)
+
+    def stopping(self, time=None):
+        """Stop: the active goal is canceled (PREEMPTED). Returns the goals to report as preempted."""
+        self._running = False
+        preempted = self._preempt_active_goal()
+        if preempted is not None:
+            self._pending.append(GoalEvent(preempted, "PREEMPTED", SUCCESSFUL, ""))
+        events, self._pending = tuple(self._pending), []
+        return events
+
+    def update(self, time, period, positions, velocities):
+        """One control cycle at sim ``time`` (s), ``period`` (s) after the last, with the measured joints.
+
+        Returns:
+            JtcUpdate.
+        """
+        if not self._running:
+            raise RuntimeError("JointTrajectoryControllerCore.update() before starting()")
+        self._time_ns, self._period_ns = to_ns(time), to_ns(period)
+        self._uptime_ns += self._period_ns
+        self._measure(positions, velocities)
+        indexes, desired, actual, error = self._update_states()
+        events = list(self._pending)
+        self._pending = []
+        if any(index is None for index in indexes):  # unreachable while uptime grows: upstream returns
+            self._log.append(("error", "Unexpected error: No trajectory defined at current time. "
+                                       "Please contact the package maintainer."))
+            return JtcUpdate(None, desired, actual, error, tuple(events), False, None)
+        events.extend(self._check_tolerances(indexes, error))
+        if self._active_goal is not None and len(self._done) == len(self.cfg.joints):
+            events.append(GoalEvent(self._active_goal, "SUCCEEDED", SUCCESSFUL, ""))
+            self._active_goal = None
+            self._done.clear()
+        commands = self._commands(desired, error)
+        return JtcUpdate(commands, desired, actual, error, tuple(events), self._state_due(), self._active_goal)
+
+    def _measure(self, positions, velocities):
+        """Keep the joints' measured positions and velocities (one per controller joint, in its order)."""
+        if len(positions) != len(self.cfg.joints) or len(velocities) != len(self.cfg.joints):
+            raise ValueError(f"{self.cfg.name}: expected positions and velocities of {len(self.cfg.joints)} "
+                             f"joints {self.cfg.joints}, got {len(positions)} and {len(velocities)}")
+        self._measured = (list(map(float, positions)), list(map(float, velocities)))
+
+    def _update_states(self):
+        """``updateStates``: desired from the trajectory at the uptime, errors with the angular distance
+        (for every joint type, as upstream), time_from_start from the first joint's segment."""
+        samples, indexes = [], []
+        uptime = to_sec(self._uptime_ns)
+        for segments in self._trajectory:
+            index, state = sample(segments, uptime)
+            indexes.append(index)
+            samples.append(state)
+        positions, velocities = self._measured
+        self._desired = ([s.position for s in samples], [s.velocity for s in samples],
+                         [s.acceleration for s in samples])
+        first = self._trajectory[0][indexes[0] if indexes[0] is not None else 0]
+        actual_tfs = uptime - first.start_time + first.time_from_start
+        n = len(samples)
+        desired = TrajectoryState(*map(tuple, self._desired), first.time_from_start)
+        actual = TrajectoryState(tuple(positions), tuple(velocities), (0.0,) * n, actual_tfs)
+        error = TrajectoryState(
+            tuple(shortest_angular_distance(p, s.position) for p, s in zip(positions, samples)),
+            tuple(s.velocity - v for v, s in zip(velocities, samples)), (0.0,) * n,
+            first.time_from_start - actual_tfs)
+        return indexes, desired, actual, error
+
+    def _check_tolerances(self, indexes, error):
+        """Path tolerances while a segment of the active goal runs, goal tolerances once its last segment
+        has ended (with ``goal_time`` of grace). Returns the abort, if any."""
+        uptime = to_sec(self._uptime_ns)
+        for joint, (segments, index) in enumerate(zip(self._trajectory, indexes)):
+            segment = segments[index]
+            if self._active_goal is None or segment.owner != self._active_goal:
+                continue
+            tolerances = segment.tolerances
+            position_error, velocity_error = error.positions[joint], error.velocities[joint]
+            name = self.cfg.joints[joint]
+            if uptime < segment.end_time:
+                if tolerances.path.violated(position_error, velocity_error):
+                    return [self._abort(PATH_TOLERANCE_VIOLATED, f"{name} path error {position_error:f}")]
+            elif index == len(segments) - 1:
+                if not tolerances.goal.violated(position_error, velocity_error):
+                    self._done.add(joint)
+                elif uptime >= segment.end_time + tolerances.goal_time:
+                    return [self._abort(GOAL_TOLERANCE_VIOLATED, f"{name} goal error {position_error:f}")]
+        return []
+
+    def _abort(self, code, text):
+        event = GoalEvent(self._active_goal, "ABORTED", code, text)
+        self._active_goal = None
+        self._done.clear()
+        return event
+
+    def _commands(self, desired, error):
+        """The hardware adapter's ``updateCommand``."""
+        if self.cfg.variant == "position":
+            return desired.positions
+        period = to_sec(self._period_ns)
+        return tuple(ff * velocity + pid.compute(position_error, period, error_dot=velocity_error)
+                     for ff, velocity, pid, position_error, velocity_error
+                     in zip(self.cfg.velocity_ff, desired.velocities, self._pids, error.positions,
+                            error.velocities))
+
+    def _state_due(self):
+        """``publishState``: due once more than a publish period has passed since the last slot."""
+        period_ns = to_ns(1.0 / self.cfg.state_publish_rate)
+        if self._last_state_publish_ns + period_ns < self._uptime_ns:
+            self._last_state_publish_ns += period_ns
+            return True
+        return False
+
+    def _hold(self, start_uptime_ns, owner=None):
+        """``setHoldPosition``: stop at the measured positions, or ramp down from the desired state."""
+        if self.cfg.stop_trajectory_duration == 0.0:
+            positions, velocities = self._measured
+        else:
+            positions, velocities = self._desired[0], self._desired[1]
+        self._trajectory = hold_trajectory(to_sec(start_uptime_ns), positions, velocities,
+                                           self.cfg.stop_trajectory_duration, owner)
+
+    def _preempt_active_goal(self):
+        goal, self._active_goal = self._active_goal, None
+        return goal
+
+    def _update_trajectory(self, joint_names, points, stamp, owner, tolerances):
+        """``updateTrajectoryCommand``: None when the trajectory was replaced, else upstream's reason."""
+        if not self._running:
+            self._log.append(("error", NOT_RUNNING))
+            return NOT_RUNNING
+        if not points:
+            self._hold(self._uptime_ns, owner)
+            return None
+        try:
+            next_update_ns, next_uptime_ns = self._time_ns + self._period_ns, self._uptime_ns + self._period_ns
+            merged = merge_trajectory(
+                self._trajectory, self.cfg.joints, self.cfg.wraparound, list(joint_names), list(points),
+                to_ns(stamp), next_update_ns, next_uptime_ns, owner, tolerances, self.cfg.allow_partial_joints_goal)
+        except TrajectoryError as err:
+            self._log.append(("warn" if str(err).startswith("Dropping all") else "error", str(err)))
+            return str(err)
+        if merged.warning:
+            self._log.append(("warn", merged.warning))
+        if not merged.trajectory:
+            return ""
+        self._trajectory = merged.trajectory
+        return None
+
+    def goal(self, goal_id, joint_names, points, stamp=0.0, path_tolerances=(), goal_tolerances=(),
+             goal_time_tolerance=0.0, time=None):
+        """A ``follow_joint_trajectory`` goal (``goalCB``).
+
+        ``points``: objects with ``positions``, ``velocities``, ``accelerations``, ``time_from_start`` (s);
+        ``stamp``: the trajectory's header stamp (s, 0 = next update); tolerances: ``(name, position,
+        velocity, acceleration)`` entries or a mapping name → (p, v, a); ``goal_time_tolerance`` in s.
+        """
+        if not self._running:
+            self._log.append(("error", GOAL_NOT_RUNNING))
+            return GoalAnswer(False, INVALID_GOAL, "")
+        joint_names = list(joint_names)
+        if (not self.cfg.allow_partial_joints_goal and len(joint_names) != len(self.cfg.joints)) \
+                or joint_mapping(joint_names, self.cfg.joints) is None:
+            self._log.append(("error", GOAL_WRONG_JOINTS))
+            return GoalAnswer(False, INVALID_JOINTS, "")
+        tolerances = resolve_goal_tolerances(self.cfg.default_tolerances, self.cfg.joints, path_tolerances,
+                                             goal_tolerances, goal_time_tolerance)
+        reason = self._update_trajectory(joint_names, points, stamp, goal_id, tolerances)
+        if reason is not None:
+            return GoalAnswer(False, INVALID_GOAL, reason)
+        preempted = self._preempt_active_goal()
+        self._active_goal = goal_id
+        return GoalAnswer(True, SUCCESSFUL, "", preempted)
+
+    def command(self, joint_names, points, stamp=0.0, time=None):
+        """A ``command`` topic message: None when executed (an active goal is then preempted, reported by
+        the next update), else upstream's reason."""
+        reason = self._update_trajectory(joint_names, points, stamp, None, None)
+        if reason is None:
+            preempted = self._preempt_active_goal()
+            if preempted is not None:
+                self._pending.append(GoalEvent(preempted, "PREEMPTED", SUCCESSFUL, ""))
+        return reason
+
+    def cancel(self, goal_id, time=None):
+        """``cancelCB``: hold if ``goal_id`` is the active goal (the caller then sets it canceled)."""
+        if self._active_goal is None or self._active_goal != goal_id:
+            return False
+        self._active_goal = None
+        self._hold(self._uptime_ns)
+        return True
+
+    def query_state(self, time):
+        """``query_state``: the trajectory's (positions, velocities, accelerations) at sim ``time`` (s), or
+        None when the controller is not running or ``time`` precedes the trajectory."""
+        if not self._running:
+            self._log.append(("error", "Can't sample trajectory. Controller is not running."))
+            return None
+        sample_time = to_sec(self._uptime_ns + (to_ns(time) - self._time_ns))
+        states = []
+        for segments in self._trajectory:
+            index, state = sample(segments, sample_time)
+            if index is None:
+                self._log.append(("error", "Requested sample time precedes trajectory start time."))
+                return None
+            states.append(state)
+        return tuple(tuple(values) for values in zip(*states))

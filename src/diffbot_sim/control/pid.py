@@ -1,0 +1,189 @@
+"""control_toolbox::Pid (ros-controls/control_toolbox noetic-devel, 1.19: ``src/pid.cpp``, ``pid.h``) in Python:
+the PID that gazebo_ros_control's DefaultRobotHWSim (``pid_gains/<joint>``), joint_trajectory_controller,
+gripper_action_controller and the effort_controllers all use.
+
+Reproduced:
+
+* ``Pid::init(NodeHandle)`` parameter reading (:func:`pid_gains`): ``p`` is required (without it upstream
+  logs ``No p gain specified for pid.  Namespace: <ns>`` and the caller falls back); ``i``, ``d`` default to 0;
+  ``i_clamp`` (default 0) sets ``i_max = |i_clamp|``, ``i_min = -|i_clamp|``; ``i_clamp_min`` / ``i_clamp_max``
+  override them as ``-|v|`` / ``+|v|``; ``antiwindup`` defaults to false.
+* ``computeCommand``: ``p = P e``; ``i_error += dt e``; with antiwindup and ``I != 0`` the ``i_error`` is clamped to
+  ``[i_min/I, i_max/I]`` (ordered), otherwise the *term* ``I i_error`` is clamped to ``[i_min, i_max]`` — so
+  with the default ``i_clamp: 0`` the integral term is always 0; ``d = D error_dot``.
+* The derivative from the last error: after ``reset()`` (and on construction) the last error 0 counts as valid,
+  so the first call kicks by ``D e / dt``. ``dt == 0`` or a non-finite error returns 0 and changes nothing;
+  a negative ``dt`` reuses the previous ``error_dot`` and still integrates, as upstream.
+
+Not reproduced: dynamic_reconfigure and the ``control_msgs/PidState`` publisher themselves (a ROS node can
+publish :attr:`Pid.terms`, which holds every field of that message but the stamp); ``updatePid`` (deprecated,
+negated) and ``initXml``.
+"""
+import math
+from dataclasses import dataclass
+from typing import Optional
+
+from diffbot_sim.errors import ConfigError
+from diffbot_sim.values import check_bool, check_number
+
+
+@dataclass(frozen=True)
+class PidGains:
+    """Gains as control_toolbox::Pid::Gains holds them. ``i_clamp_max`` >= 0 >= ``i_clamp_min`` when read
+    by :func:`pid_gains`; they bound the integral term (or ``i_error`` times I with ``antiwindup``)."""
+
+    p: float
+    i: float = 0.0
+    d: float = 0.0
+    i_clamp_max: float = 0.0
+    i_clamp_min: float = 0.0
+    antiwindup: bool = False
+
+
+@dataclass(frozen=True)
+class PidTerms:
+    """The state of the last computation: the fields of ``control_msgs/PidState`` (but its header)."""
+
+    timestep: float = 0.0
+    error: float = 0.0
+    error_dot: float = 0.0
+    p_error: float = 0.0
+    i_error: float = 0.0
+    d_error: float = 0.0
+    p_term: float = 0.0
+    i_term: float = 0.0
+    d_term: float = 0.0
+    i_max: float = 0.0
+    i_min: float = 0.0
+    output: float = 0.0
+
+
+def _namespace_dict(params, name):
+    """The PID namespace's parameters as a dict ({} when absent); anything else is a user error."""
+    if params is None:
+        return {}
+    if not isinstance(params, dict):
+        raise ConfigError(name, params, "a dictionary of PID gains (p, i, d, i_clamp, ...)")
+    return params
+
+
+def pid_gains(params, name) -> Optional[PidGains]:
+    """The gains in the rosparam dict ``params`` of the PID namespace ``name`` (e.g.
+    ``/gazebo_ros_control/pid_gains/joint1``), read as ``Pid::init`` reads them.
+
+    Returns:
+        None when there is no ``p``; upstream then logs ``No p gain specified for pid.  Namespace: <name>``
+        (see :func:`no_p_gain_message`) and the caller does without a PID.
+
+    Raises:
+        ConfigError: a gain is not a finite number or ``antiwindup`` not a bool, naming ``<name>/<key>``; or
+            ``params`` is not a dictionary.
+    """
+    params = _namespace_dict(params, name)
+    if "p" not in params:
+        return None
+
+    def number(key, default=0.0):
+        value = params.get(key, default)
+        return check_number(f"{name}/{key}", value)
+
+    i_clamp = abs(number("i_clamp"))
+    i_clamp_max, i_clamp_min = i_clamp, -i_clamp
+    if "i_clamp_min" in params:
+        i_clamp_min = -abs(number("i_clamp_min"))
+    if "i_clamp_max" in params:
+        i_clamp_max = abs(number("i_clamp_max"))
+    antiwindup = check_bool(f"{name}/antiwindup", params.get("antiwindup", False))
+    return PidGains(p=number("p"), i=number("i"), d=number("d"),
+                    i_clamp_max=i_clamp_max, i_clamp_min=i_clamp_min, antiwindup=antiwindup)
+
+
+def pid_publish_state(params, name) -> bool:
+    """``<name>/publish_state`` (default false): whether upstream publishes ``control_msgs/PidState`` on
+    ``<name>/state`` (queue 1) at every computation."""
+    params = _namespace_dict(params, name)
+    return check_bool(f"{name}/publish_state", params.get("publish_state", False))
+
+
+def no_p_gain_message(name):
+    """Upstream's ROS_ERROR text when a PID namespace has no ``p`` (two spaces before "Namespace")."""
+    return f"No p gain specified for pid.  Namespace: {name}"
+
+
+def boost_clamp(value, low, high):
+    """``boost::algorithm::clamp``: ``low`` below it, else ``high`` above it (so ``low`` > ``high`` gives
+    ``low`` for values under ``low``, ``high`` otherwise), else ``value``."""
+    if value < low:
+        return low
+    if high < value:
+        return high
+    return value
+
+
+class Pid:
+    """One PID loop with control_toolbox semantics. Units are the caller's: error in rad, m or rad/s, dt in s,
+    the output in N, N·m or whatever the gains map to.
+
+    Args:
+        gains: the :class:`PidGains` (replaceable later through :attr:`gains`, as setGains does, without
+            resetting the state).
+    """
+
+    def __init__(self, gains: PidGains):
+        self.gains = gains
+        self._p_error_last = 0.0
+        self._valid_p_error_last = True
+        self._i_error = 0.0
+        self._d_error = 0.0
+        self.terms = PidTerms()
+        self.reset()
+
+    def reset(self):
+        """Forget the integral and the last error; the next call's derivative is measured from error 0
+        (upstream's ``reset()`` marks the zeroed last error valid)."""
+        self._p_error_last = 0.0
+        self._i_error = 0.0
+        self._d_error = 0.0
+        self._valid_p_error_last = True
+        self.terms = PidTerms(i_max=self.gains.i_clamp_max, i_min=self.gains.i_clamp_min)
+
+    def compute(self, error, dt, error_dot=None):
+        """The command for ``error`` over the step ``dt`` (s).
+
+        ``error_dot`` None: the derivative is ``(error - last error) / dt`` (``computeCommand(error, dt)``);
+        otherwise the given error rate is used (``computeCommand(error, error_dot, dt)``, e.g. a velocity
+        error in joint_trajectory_controller). ``dt == 0`` or a non-finite error returns 0.
+        """
+        if error_dot is None:
+            if dt == 0 or not math.isfinite(error):
+                return 0.0
+            error_dot = self._d_error
+            if dt > 0:
+                if self._valid_p_error_last:
+                    error_dot = (error - self._p_error_last) / dt
+                self._p_error_last = error
+                self._valid_p_error_last = True
+        return self._compute_with_rate(error, error_dot, dt)
+
+    def _compute_with_rate(self, error, error_dot, dt):
+        """``computeCommand(error, error_dot, dt)``: upstream stores the errors before its validity check."""
+        gains = self.gains
+        self._d_error = error_dot
+        if dt == 0 or not math.isfinite(error) or not math.isfinite(error_dot):
+            return 0.0
+
+        p_term = gains.p * error
+        self._i_error += dt * error
+        if gains.antiwindup and gains.i != 0:
+            low, high = sorted((gains.i_clamp_min / gains.i, gains.i_clamp_max / gains.i))
+            self._i_error = boost_clamp(self._i_error, low, high)
+        i_term = gains.i * self._i_error
+        if not gains.antiwindup:
+            i_term = boost_clamp(i_term, gains.i_clamp_min, gains.i_clamp_max)
+        d_term = gains.d * error_dot
+        output = p_term + i_term + d_term
+
+        self.terms = PidTerms(timestep=dt, error=error, error_dot=error_dot, p_error=error,
+                              i_error=self._i_error, d_error=error_dot, p_term=p_term, i_term=i_term,
+                              d_term=d_term, i_max=gains.i_clamp_max, i_min=gains.i_clamp_min, output=output)
+        return output
