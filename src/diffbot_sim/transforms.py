@@ -1,8 +1,10 @@
 """Rotations and poses as plain numbers (pure; numpy only): URDF/SDF roll-pitch-yaw, (x, y, z, w)
-quaternions, and poses composed and inverted.
+quaternions, their rotation matrices, planar yaw, and poses composed and inverted.
 
 One place for the conventions every reader shares: fixed-axis roll, pitch, yaw (R = Rz(yaw) Ry(pitch)
-Rx(roll), as URDF and SDF define them) and Hamilton quaternions in ROS's (x, y, z, w) order.
+Rx(roll), as URDF and SDF define them, and as ``tf.transformations.quaternion_from_euler`` with its
+default static 'sxyz' axes computes them) and Hamilton quaternions in ROS's (x, y, z, w) order. Every
+module that turns angles into quaternions or back imports them from here.
 """
 import math
 
@@ -21,6 +23,14 @@ def rpy_matrix(rpy):
     return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
                      [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
                      [-sp, cp * sr, cp * cr]])
+
+
+def quaternion_matrix(q):
+    """Rotation matrix (3, 3) of a unit quaternion (x, y, z, w)."""
+    x, y, z, w = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
 
 
 def qmul(a, b):
@@ -73,7 +83,11 @@ def inverse(a):
 
 
 def rpy_quaternion(roll, pitch, yaw):
-    """SDF's fixed-axis roll, pitch, yaw (R = Rz(yaw) Ry(pitch) Rx(roll)) -> quaternion (x, y, z, w)."""
+    """Fixed-axis roll, pitch, yaw (R = Rz(yaw) Ry(pitch) Rx(roll); URDF, SDF) -> quaternion (x, y, z, w).
+
+    The same numbers as ``tf.transformations.quaternion_from_euler(roll, pitch, yaw)`` (axes 'sxyz'), which
+    is what gazebo_ros's spawn_model sends for ``-R -P -Y``.
+    """
     cr, sr = math.cos(roll / 2), math.sin(roll / 2)
     cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
     cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
@@ -81,3 +95,23 @@ def rpy_quaternion(roll, pitch, yaw):
             cr * sp * cy + sr * cp * sy,
             cr * cp * sy - sr * sp * cy,
             cr * cp * cy + sr * sp * sy)
+
+
+def roll_pitch_from_quaternion(x, y, z, w):
+    """(roll, pitch) [rad] of a unit quaternion, fixed-axis x-y-z (REP 103); pitch in [-pi/2, pi/2]."""
+    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
+    return roll, pitch
+
+
+# ------------------------------------------------------------------------------------------------ planar
+# A ground robot's heading: rotation about +z only (REP 103: counter-clockwise positive).
+
+def yaw_from_quaternion(x, y, z, w):
+    """Yaw [rad] about +z, in (-pi, pi], of a unit quaternion; roll and pitch are ignored."""
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def quaternion_from_yaw(yaw):
+    """(x, y, z, w) of a rotation by ``yaw`` [rad] about +z."""
+    return 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)

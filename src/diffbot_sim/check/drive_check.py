@@ -15,6 +15,7 @@ import statistics
 from dataclasses import dataclass, field
 from typing import List, NamedTuple, Optional
 
+from diffbot_sim.transforms import roll_pitch_from_quaternion, yaw_from_quaternion
 from diffbot_sim.transforms import wrap_angle as wrap  # drive_check.wrap: callers' name for it
 
 SPEED = 0.2  # m/s, the straight run's command
@@ -48,18 +49,6 @@ class BodySample(NamedTuple):
     def tilt(self):
         """Angle [rad] between the body's z axis and the world's (0 upright, pi upside down)."""
         return math.acos(max(-1.0, min(1.0, math.cos(self.roll) * math.cos(self.pitch))))
-
-
-def yaw_from_quaternion(x, y, z, w):
-    """Yaw [rad] of a unit quaternion (rotation about z, as REP 103 robots turn)."""
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
-def roll_pitch_from_quaternion(x, y, z, w):
-    """(roll, pitch) [rad] of a unit quaternion (fixed-axis x-y-z, as REP 103)."""
-    roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
-    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
-    return roll, pitch
 
 
 def body_sample(t, position, quaternion):

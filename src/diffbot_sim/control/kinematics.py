@@ -2,7 +2,9 @@
 
 Rim speeds are in m/s; a wheel joint's angular velocity is rim speed / wheel radius.
 """
-import math
+# Rotations live in diffbot_sim.transforms. Until plugins/ros_control.py and tests/integration/test_sensor_imu.py
+# import them from there, these two names are passed on from here (no code of their own).
+from diffbot_sim.transforms import quaternion_from_yaw, yaw_from_quaternion  # noqa: F401
 
 
 def wheel_speeds(linear, angular, separation):
@@ -15,12 +17,3 @@ def body_velocity(left, right, separation):
     """Forward kinematics: (left, right) rim speeds [m/s] -> body (v [m/s], w [rad/s])."""
     return (left + right) / 2.0, (right - left) / separation
 
-
-def yaw_from_quaternion(x, y, z, w):
-    """Yaw (rad, about +z, in (-pi, pi]) of a unit quaternion; roll and pitch are ignored."""
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
-def quaternion_from_yaw(yaw):
-    """(x, y, z, w) of a rotation by ``yaw`` rad about +z."""
-    return 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)

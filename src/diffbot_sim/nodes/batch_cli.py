@@ -16,6 +16,7 @@ import uuid
 
 from diffbot_sim import streams
 from diffbot_sim.batch import executors, results, scenarios
+from diffbot_sim.nodes._entry import entry_point
 
 
 def _find_package(name):
@@ -44,15 +45,10 @@ def say(text):
     streams.write(sys.stderr, text + "\n")
 
 
+@entry_point
 def main(argv=None):
-    try:
-        return _main(sys.argv[1:] if argv is None else argv)
-    finally:
-        streams.finish()
-
-
-def _main(argv):
-    args = _parser().parse_args(argv)
+    """Entry point of ``rosrun diffbot_sim batch``; returns the exit status."""
+    args = _parser().parse_args(sys.argv[1:] if argv is None else argv)
     if args.jobs < 1:
         say(f"batch: --jobs {args.jobs}: must be at least 1")
         return 2

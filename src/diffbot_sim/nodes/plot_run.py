@@ -21,6 +21,7 @@ import threading
 import time
 
 from diffbot_sim import streams
+from diffbot_sim.nodes._entry import entry_point
 from diffbot_sim.view import plot_data
 
 
@@ -128,19 +129,12 @@ def plot(data, path, title=""):
     return {"odom": data.odom[:, 1:3], "truth": truth, "truth_how": how, "scan": scan, "summary": summary}
 
 
+@entry_point
 def main(argv=None):
     """Entry point of ``rosrun diffbot_sim plot_run``."""
-    argv = sys.argv[1:] if argv is None else argv
-    try:
-        return _main(argv)
-    finally:
-        streams.finish()
-
-
-def _main(argv):
     import rospy
 
-    argv = rospy.myargv(argv)
+    argv = rospy.myargv(sys.argv[1:] if argv is None else argv)
     options = parse_argv(argv)
     if options.bag is not None:
         if not os.path.isfile(options.bag):

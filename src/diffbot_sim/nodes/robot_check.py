@@ -29,6 +29,7 @@ from diffbot_sim.check import drive_check, robot_report
 from diffbot_sim.check.session import SIM, Session, SessionError
 from diffbot_sim.description.model_files import package_path
 from diffbot_sim.errors import DiffbotSimError, ModelError
+from diffbot_sim.nodes._entry import entry_point
 
 USAGE = ("usage: rosrun diffbot_sim robot_check <model.urdf|model.urdf.xacro> [controller.yaml ...] "
          "[-- xacro args name:=value ...]")
@@ -67,23 +68,17 @@ def parse_argv(argv):
     return files[0], files[1:], " ".join(xacro_args)
 
 
-def main(argv=None):
-    """Entry point; returns the exit status (0 drives, 1 does not or bad input, 2 bad usage).
-
-    Output that cannot be written (``robot_check ... | head -3``) never changes the status:
-    :func:`diffbot_sim.streams.finish` empties the buffers first.
-    """
-    try:
-        return _main(sys.argv[1:] if argv is None else argv)
-    finally:
-        streams.finish()
-
-
 def _say(line=""):
     streams.write(sys.stdout, line + "\n")
 
 
-def _main(argv):
+@entry_point
+def main(argv=None):
+    """Entry point; returns the exit status (0 drives, 1 does not or bad input, 2 bad usage).
+
+    Output that cannot be written (``robot_check ... | head -3``) never changes the status (:mod:`._entry`).
+    """
+    argv = sys.argv[1:] if argv is None else argv
     if any(a in ("-h", "--help") for a in argv[:argv.index("--") if "--" in argv else len(argv)]):
         _say(USAGE)
         return 0

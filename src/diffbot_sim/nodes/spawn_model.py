@@ -2,7 +2,7 @@
 
 Launch files written for Gazebo run ``<node pkg="gazebo_ros" type="spawn_model" args="-urdf -param
 robot_description -model r1 -x 1 ..."/>``; overlay/gazebo_ros's ``spawn_model`` script runs this node. The
-arguments mean what they mean in ROS 1 noetic (parsed by :mod:`diffbot_sim.gazebo.cli`); the node only
+arguments mean what they mean in ROS 1 noetic (parsed by :mod:`diffbot_sim.gazebo.spawn_cli`); the node only
 does the ROS side, in upstream's order:
 
 1. ``-wait MODEL``: wait until MODEL is in ``<gazebo_ns>/model_states`` (checked at 10 Hz);
@@ -32,7 +32,7 @@ from gazebo_msgs.srv import (
 from geometry_msgs.msg import Pose
 from std_srvs.srv import Empty, EmptyRequest
 
-from diffbot_sim.gazebo import cli as gazebo_cli
+from diffbot_sim.gazebo import spawn_cli
 from diffbot_sim.gazebo.cli import CliError, UsageExit
 
 NODE_NAME = "spawn_model"
@@ -49,7 +49,7 @@ def main(argv=None):
     argv = sys.argv if argv is None else argv
     try:
         # Upstream's -robot_namespace default: the node's namespace (ROS_NAMESPACE, __ns:=), known before init.
-        args = gazebo_cli.parse_spawn_args(argv[1:], default_robot_namespace=rospy.get_namespace())
+        args = spawn_cli.parse_spawn_args(argv[1:], default_robot_namespace=rospy.get_namespace())
     except UsageExit as usage:
         (sys.stdout if usage.status == 0 else sys.stderr).write(usage.text.rstrip("\n") + "\n")
         return usage.status
@@ -108,7 +108,7 @@ def _model_xml(args):
     try:
         if args.source == "file":
             rospy.loginfo(f"Loading model XML from file {args.source_value}")
-            text = gazebo_cli.read_model_file(args.source_value)
+            text = spawn_cli.read_model_file(args.source_value)
         elif args.source == "param":
             rospy.loginfo(f"Loading model XML from ros parameter {args.source_value}")
             name = rospy.resolve_name(args.source_value)
@@ -116,14 +116,14 @@ def _model_xml(args):
                 text = rospy.get_param(name)
             except KeyError:
                 raise CliError(f"{label}: parameter {name} is not set") from None
-            gazebo_cli.check_model_text(text, f"{label} (parameter {name})")
+            spawn_cli.check_model_text(text, f"{label} (parameter {name})")
         elif args.source == "database":
             rospy.loginfo(f"Loading model XML for model://{args.source_value}")
-            text = gazebo_cli.database_xml(args.source_value)
+            text = spawn_cli.database_xml(args.source_value)
         else:
             rospy.loginfo("Loading model XML from stdin")
-            text = gazebo_cli.check_model_text(sys.stdin.read(), "-stdin: standard input")
-        return gazebo_cli.prepare_model_xml(text, label, args.package_to_model)
+            text = spawn_cli.check_model_text(sys.stdin.read(), "-stdin: standard input")
+        return spawn_cli.prepare_model_xml(text, label, args.package_to_model)
     except CliError as err:
         raise SpawnFailed(str(err)) from None
 

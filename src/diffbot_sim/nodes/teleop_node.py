@@ -33,11 +33,12 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
 from diffbot_sim import streams
-from diffbot_sim.control.kinematics import yaw_from_quaternion
 from diffbot_sim.errors import ConfigError, TerminalError
+from diffbot_sim.nodes._entry import entry_point
 from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.teleop.keymap import BANNER, STOP, Teleop, TeleopConfig, format_status
 from diffbot_sim.teleop.terminal import EOF, StatusLine, raw_terminal, read_key, require_tty
+from diffbot_sim.transforms import yaw_from_quaternion
 
 NODE_NAME = "teleop_key"
 #: Longest wait for a key; bounds how late a ROS shutdown request and the status line are noticed.
@@ -49,20 +50,13 @@ DRAIN_TIMEOUT = 0.5
 _SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
+@entry_point
 def main():
     """Run the node; return the process exit status.
 
-    Output that cannot be written (a hung-up terminal, ``teleop_key | head -1``) never changes the status:
-    :func:`diffbot_sim.streams.finish` empties the buffers before the interpreter's own final flush would
-    fail with status 120.
+    Output that cannot be written (a hung-up terminal, ``teleop_key | head -1``) never changes the status
+    (:mod:`._entry`).
     """
-    try:
-        return _main()
-    finally:
-        streams.finish()
-
-
-def _main():
     stdin = 0
     try:
         require_tty(stdin)

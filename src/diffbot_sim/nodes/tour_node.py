@@ -16,10 +16,10 @@ import tf2_ros
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
-from diffbot_sim import streams
-from diffbot_sim.check.drive_check import yaw_from_quaternion
 from diffbot_sim.control.waypoint_tour import Tour, TourConfig
 from diffbot_sim.errors import ConfigError
+from diffbot_sim.nodes._entry import entry_point
+from diffbot_sim.transforms import yaw_from_quaternion
 from diffbot_sim.values import check_number
 
 
@@ -35,15 +35,9 @@ def read_waypoints(value):
     return points
 
 
+@entry_point
 def main(argv=None):
     """Entry point of ``rosrun diffbot_sim tour``; returns the exit status."""
-    try:
-        return _main()
-    finally:
-        streams.finish()
-
-
-def _main():
     rospy.init_node("tour")
     try:
         waypoints = read_waypoints(rospy.get_param("~waypoints", None))

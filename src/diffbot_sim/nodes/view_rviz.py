@@ -65,7 +65,7 @@ def _wait_param(master, name, timeout):
 def robot_views(master, sim, timeout):
     """A :class:`rviz_config.RobotView` per robot of the simulator at ``sim``, from its effective
     parameters and the topics it publishes."""
-    from diffbot_sim.nodes.world_markers import robot_namespaces
+    from diffbot_sim.world.loading import robot_namespaces
 
     entries = _param(master, sim + "/robots")
     names = robot_namespaces(entries)
@@ -91,10 +91,12 @@ def robot_views(master, sim, timeout):
 
 def world_bounds(sim):
     """The world's static geometry extent in the world frame, or None without a world."""
-    from diffbot_sim.nodes.world_markers import _read_world
+    import rospy
+
+    from diffbot_sim.world.loading import simulator_world
     from diffbot_sim.world.markers import bounds_xy, marker_specs
 
-    world = _read_world(sim)
+    world = simulator_world(sim, rospy.get_param)
     return bounds_xy(marker_specs(world)) if world is not None else None
 
 

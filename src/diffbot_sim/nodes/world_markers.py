@@ -27,11 +27,12 @@ Parameters:
 
 Exit status 1, with one line, on a world file that cannot be read or a simulator that never reports.
 """
-import math
 import time
 
-from diffbot_sim import streams
 from diffbot_sim.errors import DiffbotSimError
+from diffbot_sim.nodes._entry import entry_point
+from diffbot_sim.transforms import quaternion_from_yaw
+from diffbot_sim.world.loading import robot_namespaces, simulator_world
 from diffbot_sim.world.markers import CUBE, CYLINDER, MESH_RESOURCE, SPHERE, TRIANGLE_LIST, marker_specs
 
 _KINDS = {CUBE: 1, SPHERE: 2, CYLINDER: 3, MESH_RESOURCE: 10, TRIANGLE_LIST: 11}  # Marker type constants
@@ -89,27 +90,7 @@ def odom_offset(source, x, y, yaw):
     where the robot was spawned)."""
     if source != "encoder":
         return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)
-    return (float(x), float(y), 0.0), (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
-
-
-def robot_namespaces(robots):
-    """The private sub-namespaces of the simulator's robots: ``[""]`` for the one robot of ``x, y, yaw``
-    (no ``~robots``), else each entry's ``name`` (``~robots`` entries are names or dicts)."""
-    if robots is None:
-        return [""]
-    return [entry["name"] if isinstance(entry, dict) else str(entry) for entry in robots]
-
-
-def _read_world(sim):
-    """The simulator's world, read from its ``~world`` parameter through the loader it uses itself."""
-    import rospy
-
-    from diffbot_sim.world.loading import load_world
-
-    name = rospy.get_param(sim + "/world", "") or rospy.get_param(sim + "/world_name", "")
-    if not name:
-        return None
-    return load_world(name, float(rospy.get_param(sim + "/map_wall_height", 1.0)))
+    return (float(x), float(y), 0.0), quaternion_from_yaw(yaw)
 
 
 def _wait(predicate, timeout, what):
@@ -144,15 +125,9 @@ def _odom_frames(sim, timeout):
     return out
 
 
+@entry_point
 def main():
     """Entry point of ``rosrun diffbot_sim world_markers``."""
-    try:
-        return _main()
-    finally:
-        streams.finish()
-
-
-def _main():
     import rospy
     import tf2_ros
     from geometry_msgs.msg import TransformStamped
@@ -164,7 +139,7 @@ def _main():
     timeout = float(rospy.get_param("~timeout", 60.0))
     pub = rospy.Publisher("world_markers", MarkerArray, queue_size=1, latch=True)
     try:
-        world = _read_world(sim)
+        world = simulator_world(sim, rospy.get_param)
         warnings = []
         if world is not None:
             array = make_marker_array(world, frame_id, warnings)

@@ -180,8 +180,9 @@ class Plugin:
         return math.inf
 
     def next_publish(self):
-        """Sim time at which ``after_step`` has work (publishing)."""
-        return math.inf
+        """Sim time at which ``after_step`` has work (publishing): the next scheduled publication
+        (``self.next``, which ``take_due`` moves on). A plugin that publishes nothing returns inf."""
+        return self.next
 
     def before_step(self, now):
         """Apply new commands and run control that is due (called before each physics step, and at once

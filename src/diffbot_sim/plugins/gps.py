@@ -116,14 +116,10 @@ class Gps(Plugin):
         frame = ctx.clean_frame(values["frame"], path) or "world"
         self.frame_id = frame if frame in ("world", "map") else ctx.frame(frame)
         self.covariance = covariance(values["position"])
-        self.next = 0.0
         self.last_time = None
 
     def publishers(self):
         return [self.fix_pub, self.vel_pub]
-
-    def next_publish(self):
-        return self.next
 
     def start(self, now):
         self.next, self.last_time = now, None

@@ -14,13 +14,9 @@ class GroundTruth(Plugin):
         self.pub = ctx.publisher(ctx.private + "ground_truth", Odometry)
         self.builder = ros_msgs.OdometryBuilder("world", child_frame, 0.0, 0.0, 0.0)
         self.period = 1.0 / rate
-        self.next = 0.0
 
     def publishers(self):
         return [self.pub]
-
-    def next_publish(self):
-        return self.next
 
     def after_step(self, now, stamp, transforms):
         if not self.take_due(now, self.period):

@@ -362,7 +362,6 @@ class ImuPlugin(Plugin):
             from std_srvs.srv import Empty, EmptyResponse
 
             self.service = ctx.service(join(ns, settings.service), Empty, lambda _req: EmptyResponse())
-        self.next = 0.0
         self.last_time = None
         self.velocity = None
         for note in getattr(settings, "unknown", []):
@@ -370,9 +369,6 @@ class ImuPlugin(Plugin):
 
     def publishers(self):
         return [self.pub] + ([self.bias_pub] if self.bias_pub is not None else [])
-
-    def next_publish(self):
-        return self.next
 
     def start(self, now):
         self.next, self.last_time, self.velocity = now, None, None

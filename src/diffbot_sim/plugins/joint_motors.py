@@ -48,6 +48,10 @@ class JointMotors(Plugin):
     def joints(self):
         return set(self.transmissions)
 
+    def next_publish(self):
+        """Never: the motors only take commands; ``after_step`` has nothing to do."""
+        return math.inf
+
     def _on_command(self, msg, joint):
         """Keep the newest finite command per joint (validated here, like cmd_vel)."""
         if not math.isfinite(msg.data):

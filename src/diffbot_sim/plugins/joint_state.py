@@ -20,13 +20,9 @@ class JointStatePublisher(Plugin):
         self.pub = ctx.publisher(topic or join(cfg.namespace, cfg.topic), JointState)
         self.builder = ros_msgs.JointStateBuilder(list(cfg.joints))
         self.period = 1.0 / cfg.update_rate if cfg.update_rate > 0 else 0.0
-        self.next = 0.0
 
     def publishers(self):
         return [self.pub]
-
-    def next_publish(self):
-        return self.next
 
     def after_step(self, now, stamp, transforms):
         if not self.take_due(now, self.period):

@@ -23,12 +23,13 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import Empty
 
-from diffbot_sim.control.kinematics import quaternion_from_yaw, wheel_speeds
+from diffbot_sim.control.kinematics import wheel_speeds
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ModelError
 from diffbot_sim.plugins.base import Plugin, finite_twist, join
 from diffbot_sim.plugins.joint_motors import UNLIMITED_EFFORT
 from diffbot_sim.ros import messages as ros_msgs
+from diffbot_sim.transforms import quaternion_from_yaw
 from diffbot_sim.values import check_bool, check_string, tag_number
 
 REQUIRED = ("left_wheel_joint_name", "right_wheel_joint_name", "wheel_separation", "wheel_diameter",
@@ -64,7 +65,6 @@ class Kobuki(Plugin):
         self.x = self.y = self.yaw = 0.0
         self.last_time = None
         self._imu_velocity = None  # world velocity of the base frame at the last update (accelerometer)
-        self.next = 0.0
         self._lock = threading.Lock()
         self._pending = None
         self._reset_odom = False
@@ -109,9 +109,6 @@ class Kobuki(Plugin):
         if self.cmd_time is not None and self.wheel_cmd != (0.0, 0.0):
             return self.cmd_time + self.timeout
         return math.inf
-
-    def next_publish(self):
-        return self.next
 
     def before_step(self, now):
         if self._pending is not None:

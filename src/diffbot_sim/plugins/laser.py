@@ -1,7 +1,7 @@
 """Laser scanners on ``<sensor type="ray|gpu_ray">``: ROS 1 ``libgazebo_ros_laser.so`` and
 ``libgazebo_ros_gpu_laser.so`` (sensor_msgs/LaserScan), ROS 2 ``libgazebo_ros_ray_sensor.so`` (LaserScan,
-PointCloud2, PointCloud or Range, by ``<output_type>``). Also the shared ray-sensor machinery
-(:class:`RaySensorPlugin`) that :mod:`diffbot_sim.plugins.range` uses.
+PointCloud2, PointCloud or Range, by ``<output_type>``). What every ray sensor's plugin shares (the sensor on
+its link, the schedule, the casting, gazebo_ros's ROS 1 tags) is :mod:`diffbot_sim.plugins.ray_base`.
 
 What the scan contains (angles, +inf misses, noise, intensities) is :mod:`diffbot_sim.sensors.ray`; the
 casting is ``World.ray_batch``. As gazebo_ros does:
@@ -22,9 +22,9 @@ casting is ``World.ray_batch``. As gazebo_ros does:
 """
 from sensor_msgs.msg import LaserScan, PointCloud, PointCloud2, Range
 
-from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ConfigError
-from diffbot_sim.plugins.base import Plugin, join, summary_key
+from diffbot_sim.plugins import ray_base
+from diffbot_sim.plugins.base import join
 from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.sensors import ray as ray_sensor
 from diffbot_sim.values import check_string, tag_number
@@ -35,97 +35,7 @@ OUTPUT_TYPES = {"sensor_msgs/LaserScan": LaserScan, "sensor_msgs/PointCloud2": P
                 "sensor_msgs/PointCloud": PointCloud, "sensor_msgs/Range": Range}
 
 
-def plugin_tags(element):
-    """{tag: text} of a plugin element's direct children (text or ``value=`` form)."""
-    return {child.tag: tag_value(child) for child in element}
-
-
-def sensor_seed(ctx, where):
-    """The noise seed: the simulator's ``~seed`` (validated in SimConfig), so two runs are identical."""
-    return ctx.cfg.seed
-
-
-def ros1_frame(ctx, values, sensor, path, warn=True):
-    """The frame a ROS 1 ray plugin publishes in: ``frameName``, else the sensor's link (gazebo_ros says
-    ``/world``: with a warning when ``warn``), without a leading slash, with the robot's tf_prefix."""
-    if "frameName" in values:
-        frame = check_string(f"<frameName> of {path}", values["frameName"])
-    else:
-        frame = sensor.link or "world"
-        if warn:
-            ctx.warnings.append(f"{path}: no <frameName>: using the sensor's link '{frame}' (gazebo_ros would "
-                                "say /world)")
-    return ctx.frame(ctx.clean_frame(frame, path))
-
-
-def ros1_namespace(ctx, values):
-    """gazebo_ros's GetRobotNamespace: tag absent -> the node's ("/"), present but empty -> the model name."""
-    if "robotNamespace" in values:
-        return ctx.plugin_namespace(values["robotNamespace"].strip() or ctx.model.name, "/")
-    return ctx.plugin_namespace(None, "/")
-
-
-class RaySensorPlugin(Plugin):
-    """A ray sensor mounted on a robot link: schedule, pose and casting; subclasses publish."""
-
-    def __init__(self, ctx, sensor, plugin_element, path):
-        self.ctx = ctx
-        self.path = path
-        self.cfg = cfg = ray_sensor.parse_sensor(sensor.element, sensor.path)
-        ctx.warnings.extend(cfg.warnings)
-        self.name = sensor.name or sensor.path
-        self.link = sensor.link
-        model = ctx.model
-        if not self.link or self.link not in model.links:
-            raise ConfigError(f"<gazebo reference> of {sensor.path}", self.link,
-                              "the name of a link of the model (a sensor is mounted on a link)")
-        self.pose = cfg.pose
-        parent_joint = next((j for j in model.joints.values() if j.child == self.link), None)
-        if parent_joint is not None and parent_joint.type == "fixed":
-            if cfg.has_pose and any(v != 0.0 for v in cfg.pose[0] + cfg.pose[1]):
-                ctx.warnings.append(f"{sensor.path}: <pose> dropped: link '{self.link}' is lumped into its parent "
-                                    "by a fixed joint, and Gazebo then puts the sensor at the link's frame")
-            self.pose = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
-        self.directions = ray_sensor.ray_directions(cfg)
-        rng = ray_sensor.noise_rng(sensor_seed(ctx, sensor.path), f"{ctx.spec.name or ''}/{self.name}")
-        self.rng = rng
-        self.processor = ray_sensor.ScanProcessor(cfg, rng)
-        self.period = 1.0 / cfg.update_rate if cfg.update_rate > 0 else 0.0
-        self.next = 0.0
-        self.pub = None
-
-    def publishers(self):
-        return [self.pub] if self.pub is not None else []
-
-    def next_publish(self):
-        return self.next
-
-    def cast(self):
-        """(hit fractions, retro values) of this sensor's rays from its current pose."""
-        cfg = self.cfg
-        position, quaternion = self.ctx.robot.link_pose(self.link)
-        origin, rotation = ray_sensor.sensor_pose(position, quaternion, self.pose)
-        starts, ends = ray_sensor.world_rays(origin, rotation, self.directions, cfg.range_min, cfg.range_max)
-        world = self.ctx.sim.world
-        fractions, bodies, links = world.ray_batch(starts, ends)
-        return fractions, world.retro(bodies, links)
-
-    def after_step(self, now, stamp, transforms):
-        if not self.take_due(now, self.period):
-            return
-        if self.pub is not None and self.pub.get_num_connections():  # lazy, as gazebo_ros
-            self.publish(now, stamp)
-
-    def publish(self, now, stamp):
-        raise NotImplementedError
-
-    def describe(self, topic, frame):
-        rate = f"{self.cfg.update_rate:g} Hz" if self.cfg.update_rate > 0 else "every step"
-        return {summary_key("sensor", self.name): f"{self.filename} topic {topic} frame {frame} rays {self.cfg.rays} "
-                                       f"readings {self.cfg.readings} {rate}"}
-
-
-class Laser(RaySensorPlugin):
+class Laser(ray_base.RaySensorPlugin):
     """A laser scanner: LaserScan (ROS 1 and 2), or the ROS 2 plugin's PointCloud2/PointCloud/Range."""
 
     def __init__(self, ctx, sensor, plugin_element, path, filename, topic, frame, output="sensor_msgs/LaserScan",
@@ -176,18 +86,19 @@ _ROS1_READ = ("robotNamespace", "topicName", "frameName")
 
 
 def _ros1(ctx, sensor, element, path, filename):
-    values = plugin_tags(element)
+    values = ray_base.plugin_tags(element)
     ignored = [t for t in values if t not in _ROS1_READ]
     if ignored:
         ctx.warnings.append(f"{path}: tags ignored, as {filename} reads only robotNamespace, topicName and "
                             f"frameName (rate and noise come from the <sensor>): {', '.join(ignored)}")
-    ns = ros1_namespace(ctx, values)
+    ns = ray_base.ros1_namespace(ctx, values)
     if "topicName" in values:
         topic = check_string(f"<topicName> of {path}", values["topicName"])
     else:
         topic = "/world"
         ctx.warnings.append(f"{path}: no <topicName>: publishing on /world, {filename}'s default")
-    return Laser(ctx, sensor, element, path, filename, join(ns, topic), ros1_frame(ctx, values, sensor, path))
+    frame = ray_base.ros1_frame(ctx, values, sensor, path)
+    return Laser(ctx, sensor, element, path, filename, join(ns, topic), frame)
 
 
 def ros2_topic(ctx, element, plugin_name, default_ns="/"):
@@ -211,7 +122,7 @@ def ros2_topic(ctx, element, plugin_name, default_ns="/"):
 
 
 def _ros2(ctx, sensor, element, path):
-    values = plugin_tags(element)
+    values = ray_base.plugin_tags(element)
     output = values.get("output_type", "").strip()
     if not output:
         output = "sensor_msgs/PointCloud2"
@@ -235,25 +146,15 @@ def _ros2(ctx, sensor, element, path):
                  radiation == "ultrasound")
 
 
-def _plugin_path(sensor, element):
-    name = element.get("name")
-    return f"{sensor.path}/plugin[@name='{name}']" if name else f"{sensor.path}/plugin"
-
-
-def _check_type(sensor, path):
-    if sensor.type not in ray_sensor.RAY_TYPES:
-        raise ConfigError(f"<sensor type> of {path}", sensor.type, "ray or gpu_ray (a ray sensor's plugin)")
-
-
 def create_laser(ctx, sensor, element, params):
-    path = _plugin_path(sensor, element)
-    _check_type(sensor, path)
+    path = ray_base.plugin_path(sensor, element)
+    ray_base.check_type(sensor, path)
     base = (element.get("filename") or "").strip().rsplit("/", 1)[-1]
     filename = "libgazebo_ros_gpu_laser.so" if "gpu" in base else "libgazebo_ros_laser.so"
     return _ros1(ctx, sensor, element, path, filename)
 
 
 def create_ray_sensor(ctx, sensor, element, params):
-    path = _plugin_path(sensor, element)
-    _check_type(sensor, path)
+    path = ray_base.plugin_path(sensor, element)
+    ray_base.check_type(sensor, path)
     return _ros2(ctx, sensor, element, path)

@@ -75,13 +75,9 @@ class P3D(Plugin):
         self.child = ctx.frame(ctx.clean_frame(values["body"], path))
         gn2 = values["gaussian_noise"] ** 2
         self.covariance = (gn2,) * 6
-        self.next = 0.0
 
     def publishers(self):
         return [self.pub]
-
-    def next_publish(self):
-        return self.next
 
     def start(self, now):
         self.next = now

@@ -36,7 +36,6 @@ class PlanarMove(Plugin):
         self.timeout = timeout if timeout > 0 else ctx.cfg.cmd_vel_timeout
         self.command = (0.0, 0.0, 0.0)
         self.stamp = None
-        self.next = 0.0
         self._lock = threading.Lock()
         self._pending = None
         self.sub = ctx.subscriber(join(ns, values["commandTopic"]), Twist, self._on_twist, queue_size=1)
@@ -58,9 +57,6 @@ class PlanarMove(Plugin):
 
     def next_due(self):
         return self.ctx.sim.sim_time  # the body velocity is set every step, as Gazebo does
-
-    def next_publish(self):
-        return self.next
 
     def before_step(self, now):
         if self._pending is not None:

@@ -13,15 +13,8 @@ warning; gazebo_ros says ``/world``); ``radiation`` (``ultrasound``, anything el
 """
 from sensor_msgs.msg import Range as RangeMsg
 
+from diffbot_sim.plugins import ray_base
 from diffbot_sim.plugins.base import join
-from diffbot_sim.plugins.laser import (
-    RaySensorPlugin,
-    _check_type,
-    _plugin_path,
-    plugin_tags,
-    ros1_frame,
-    ros1_namespace,
-)
 from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.sensors import ray as ray_sensor
 from diffbot_sim.values import check_string, tag_number
@@ -29,7 +22,7 @@ from diffbot_sim.values import check_string, tag_number
 _READ = ("robotNamespace", "topicName", "frameName", "radiation", "fov", "gaussianNoise", "updateRate")
 
 
-class RangeSensor(RaySensorPlugin):
+class RangeSensor(ray_base.RaySensorPlugin):
     filename = "libgazebo_ros_range.so"
 
     def __init__(self, ctx, sensor, element, path, topic, frame, ultrasound, fov, stddev, update_rate):
@@ -58,15 +51,15 @@ class RangeSensor(RaySensorPlugin):
 
 
 def create(ctx, sensor, element, params):
-    path = _plugin_path(sensor, element)
-    _check_type(sensor, path)
-    values = plugin_tags(element)
+    path = ray_base.plugin_path(sensor, element)
+    ray_base.check_type(sensor, path)
+    values = ray_base.plugin_tags(element)
     ignored = [t for t in values if t not in _READ]
     if ignored:
         ctx.warnings.append(f"{path}: tags ignored (gazebo_ros_range does not read them): {', '.join(ignored)}")
-    ns = ros1_namespace(ctx, values)
+    ns = ray_base.ros1_namespace(ctx, values)
     topic = check_string(f"<topicName> of {path}", values["topicName"]) if "topicName" in values else "/range"
-    frame = ros1_frame(ctx, values, sensor, path)
+    frame = ray_base.ros1_frame(ctx, values, sensor, path)
     ultrasound = values.get("radiation", "ultrasound").strip() == "ultrasound"
     fov = tag_number(f"<fov> of {path}", values["fov"], ctx.warnings, low=0.0) if "fov" in values else 0.05
     stddev = tag_number(f"<gaussianNoise> of {path}", values["gaussianNoise"], ctx.warnings, low=0.0) \

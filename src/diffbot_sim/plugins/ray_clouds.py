@@ -1,7 +1,7 @@
 """Ray sensors that publish point clouds: ``libgazebo_ros_block_laser.so`` (ROS 1, sensor_msgs/PointCloud)
 and ``libgazebo_ros_velodyne_laser.so`` / ``libgazebo_ros_velodyne_gpu_laser.so`` (velodyne_simulator,
 sensor_msgs/PointCloud2 with x, y, z, intensity, ring, time). Casting and range semantics are the laser's
-(:class:`diffbot_sim.plugins.laser.RaySensorPlugin`, :mod:`diffbot_sim.sensors.ray`).
+(:class:`diffbot_sim.plugins.ray_base.RaySensorPlugin`, :mod:`diffbot_sim.sensors.ray`).
 
 * Block laser (gazebo_ros_block_laser, sensors.md §1.2): tags ``robotNamespace``, ``topicName`` (``/world``),
   ``frameName``, ``gaussianNoise`` (0, on x, y, z of every finite point); ``hokuyoMinIntensity`` and
@@ -16,15 +16,8 @@ sensor_msgs/PointCloud2 with x, y, z, intensity, ring, time). Casting and range 
 import numpy as np
 from sensor_msgs.msg import PointCloud, PointCloud2
 
+from diffbot_sim.plugins import ray_base
 from diffbot_sim.plugins.base import join
-from diffbot_sim.plugins.laser import (
-    RaySensorPlugin,
-    _check_type,
-    _plugin_path,
-    plugin_tags,
-    ros1_frame,
-    ros1_namespace,
-)
 from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.values import check_bool, tag_number
 
@@ -47,13 +40,13 @@ def _points(ranges, azimuth, inclination):
                          r * np.sin(inclination)], axis=1)
 
 
-class BlockLaser(RaySensorPlugin):
+class BlockLaser(ray_base.RaySensorPlugin):
     filename = BLOCK
 
     def __init__(self, ctx, sensor, element, path, values):
         super().__init__(ctx, sensor, element, path)
-        ns = ros1_namespace(ctx, values)
-        self.frame = ros1_frame(ctx, values, sensor, path, warn=False)
+        ns = ray_base.ros1_namespace(ctx, values)
+        self.frame = ray_base.ros1_frame(ctx, values, sensor, path, warn=False)
         self.noise = tag_number(f"<gaussianNoise> of {path}", values.get("gaussianNoise", 0.0), ctx.warnings,
                                 low=0.0)
         self.pub = ctx.publisher(join(ns, values.get("topicName") or "/world"), PointCloud)
@@ -73,14 +66,14 @@ class BlockLaser(RaySensorPlugin):
         return self.describe(self.pub.resolved_name, self.frame)
 
 
-class VelodyneLaser(RaySensorPlugin):
+class VelodyneLaser(ray_base.RaySensorPlugin):
     filename = VELODYNE[0]
 
     def __init__(self, ctx, sensor, element, path, values):
         super().__init__(ctx, sensor, element, path)
-        ns = ros1_namespace(ctx, values)
+        ns = ray_base.ros1_namespace(ctx, values)
         label = lambda tag: f"<{tag}> of {path}"  # noqa: E731
-        self.frame = ros1_frame(ctx, values, sensor, path, warn=False)
+        self.frame = ray_base.ros1_frame(ctx, values, sensor, path, warn=False)
         notes = ctx.warnings
         self.min_range = tag_number(label("min_range"), values.get("min_range", 0.9), notes, low=0.0)
         self.max_range = tag_number(label("max_range"), values.get("max_range", 130.0), notes, low=0.0,
@@ -116,14 +109,14 @@ class VelodyneLaser(RaySensorPlugin):
 
 
 def create_block(ctx, sensor, element, params):
-    path = _plugin_path(sensor, element)
-    _check_type(sensor, path)
-    return BlockLaser(ctx, sensor, element, path, plugin_tags(element))
+    path = ray_base.plugin_path(sensor, element)
+    ray_base.check_type(sensor, path)
+    return BlockLaser(ctx, sensor, element, path, ray_base.plugin_tags(element))
 
 
 def create_velodyne(ctx, sensor, element, params):
-    path = _plugin_path(sensor, element)
-    _check_type(sensor, path)
-    return VelodyneLaser(ctx, sensor, element, path, plugin_tags(element))
+    path = ray_base.plugin_path(sensor, element)
+    ray_base.check_type(sensor, path)
+    return VelodyneLaser(ctx, sensor, element, path, ray_base.plugin_tags(element))
 
 

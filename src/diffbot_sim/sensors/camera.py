@@ -23,6 +23,7 @@ import numpy as np
 
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ConfigError
+from diffbot_sim.transforms import qmul, quaternion_matrix, rpy_quaternion
 from diffbot_sim.values import check_number, tag_number
 
 CAMERA_TYPES = ("camera", "depth")
@@ -178,33 +179,12 @@ def body_to_optical(point):
 
 
 # -- rendering ---------------------------------------------------------------------------------------------
-def quaternion_matrix(q):
-    """Rotation matrix of a unit quaternion (x, y, z, w)."""
-    x, y, z, w = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-
-
-def rpy_quaternion(roll, pitch, yaw):
-    """Quaternion (x, y, z, w) of fixed-axis roll, pitch, yaw (URDF and SDF)."""
-    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
-    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
-    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy,
-            cr * cp * cy + sr * sp * sy)
-
-
 def sensor_view(link_pose, pose):
     """World pose (position, quaternion) of a sensor at ``pose`` (xyz, rpy) in a link at ``link_pose``."""
     position, quat = link_pose
     rot = quaternion_matrix(quat)
     offset = rot @ np.asarray(pose[0], float)
-    q1, q2 = quat, rpy_quaternion(*pose[1])
-    x1, y1, z1, w1 = q1
-    x2, y2, z2, w2 = q2
-    q = (w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2, w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-         w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2, w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2)
+    q = qmul(quat, rpy_quaternion(*pose[1]))
     return tuple(float(v) for v in np.asarray(position, float) + offset), q
 
 

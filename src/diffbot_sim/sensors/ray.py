@@ -24,7 +24,7 @@ import numpy as np
 
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ConfigError
-from diffbot_sim.transforms import rpy_matrix
+from diffbot_sim.transforms import quaternion_matrix, rpy_matrix
 from diffbot_sim.values import check_bool, check_number, tag_number
 
 
@@ -201,14 +201,6 @@ def parse_sensor(element, path, name=None):
 
 
 # -- geometry -----------------------------------------------------------------------------------------------
-def quaternion_matrix(q):
-    """Rotation matrix of a unit quaternion (x, y, z, w)."""
-    x, y, z, w = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-
-
 def ray_directions(cfg):
     """Unit vectors of the cast rays in the sensor frame, (rays, 3): vertical rows of horizontal sweeps.
     Yaw counter-clockwise about z from x; a positive vertical angle points up (Gazebo: pitch about -y)."""

@@ -17,7 +17,7 @@ from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
-from diffbot_sim.transforms import compose, inverse
+from diffbot_sim.transforms import compose, inverse, yaw_from_quaternion
 
 IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
@@ -40,10 +40,6 @@ class RunData:
     tf: "TfTree" = None
     odom_topic: str = ""
     truth_topic: str = ""
-
-
-def _yaw(q):
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
 def _pose(transform):
@@ -123,7 +119,7 @@ def collect(records):
         seen.add(f"{topic} ({kind})")
         if kind == "nav_msgs/Odometry":
             p, q, v = msg.pose.pose.position, msg.pose.pose.orientation, msg.twist.twist
-            row = (msg.header.stamp.to_sec(), p.x, p.y, _yaw(q), v.linear.x, v.angular.z)
+            row = (msg.header.stamp.to_sec(), p.x, p.y, yaw_from_quaternion(q.x, q.y, q.z, q.w), v.linear.x, v.angular.z)
             which = "truth" if msg.header.frame_id.lstrip("/") == "world" else "odom"
             if topics[which] and topics[which] != topic:
                 continue  # a second robot or odometry source: the first one seen is the one drawn

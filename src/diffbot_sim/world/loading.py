@@ -1,6 +1,8 @@
 """Which world file a world name means, and reading it (pure): an SDF ``.world`` through
 :mod:`diffbot_sim.world.sdf_reader`, a map_server ``.yaml`` through :mod:`diffbot_sim.world.map_image`. The
-simulator and ``world_markers`` read a world through this one module."""
+simulator, ``world_markers`` and ``view_rviz`` read a world through this one module; the last two find it,
+and the simulator's robots, from the running simulator's parameters (:func:`simulator_world`,
+:func:`robot_namespaces`)."""
 import os
 
 from diffbot_sim.description.model_files import package_path
@@ -44,3 +46,28 @@ def load_world(name, map_wall_height):
     if path.endswith((".yaml", ".yml")):
         return read_map(path, map_wall_height)
     return read_world(path, package_model_paths=ros_package_model_paths())
+
+
+# -- the world of a running simulator, from its parameters (read by the caller: no rospy here) -----------
+
+def simulator_world(sim, get_param):
+    """The world a running ``bullet_sim`` at node name ``sim`` simulates, read as it reads it
+    (:func:`load_world` of its ``world`` or ``world_name`` parameter, walls ``map_wall_height`` m high);
+    None when it has no world. ``get_param(name, default)`` reads the parameter server
+    (``rospy.get_param``), so ``world_markers`` and ``view_rviz`` draw exactly the simulated world.
+
+    Raises:
+        ModelError: a missing or malformed file, named.
+    """
+    name = get_param(sim + "/world", "") or get_param(sim + "/world_name", "")
+    if not name:
+        return None
+    return load_world(name, float(get_param(sim + "/map_wall_height", 1.0)))
+
+
+def robot_namespaces(robots):
+    """The private sub-namespaces of a simulator's robots, from its ``robots`` parameter: ``[""]`` for the
+    one robot of ``x, y, yaw`` (no ``~robots``), else each entry's ``name`` (entries are names or dicts)."""
+    if robots is None:
+        return [""]
+    return [entry["name"] if isinstance(entry, dict) else str(entry) for entry in robots]

@@ -263,8 +263,3 @@ def test_body_sample_from_a_quaternion():
     assert (s.roll, s.pitch, s.yaw) == pytest.approx((0.5, 0.0, 0.0)) and s.tilt == pytest.approx(0.5)
     s = drive_check.body_sample(1.0, (1, 2, 3), (0, math.sin(0.15), 0, math.cos(0.15)))  # pitch 0.3
     assert (s.roll, s.pitch) == pytest.approx((0.0, 0.3)) and s.tilt == pytest.approx(0.3)
-
-
-def test_yaw_from_quaternion():
-    import math
-    assert drive_check.yaw_from_quaternion(0, 0, math.sin(0.4), math.cos(0.4)) == pytest.approx(0.8)

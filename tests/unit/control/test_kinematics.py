@@ -49,13 +49,3 @@ def test_arc_radius():
     assert left == pytest.approx(angular * (radius - separation / 2))
     assert right == pytest.approx(angular * (radius + separation / 2))
     assert math.isclose(right / left, (radius + 0.1) / (radius - 0.1))
-
-
-def test_planar_quaternion_round_trip():
-    import math
-
-    from diffbot_sim.control.kinematics import quaternion_from_yaw, yaw_from_quaternion
-
-    for yaw in (-3.0, -1.0, 0.0, 0.5, 3.0):
-        assert yaw_from_quaternion(*quaternion_from_yaw(yaw)) == pytest.approx(yaw)
-    assert quaternion_from_yaw(math.pi / 2)[2] == pytest.approx(math.sqrt(0.5))

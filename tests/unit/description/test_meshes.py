@@ -529,7 +529,12 @@ def test_pybullet_cannot_read_ascii_stl_itself(model, world):
 # -------------------------------------------------------------------------------------------------- speed
 
 def test_two_megabyte_stl_cold_and_cached(tmp_path):
-    """~2 MB binary STL (40 000 triangles): converted well within the 2 s start-up budget; cached ~free."""
+    """~2 MB binary STL (40 000 triangles): converted well within the 2 s start-up budget; cached ~free.
+
+    Measured here (2 cores): about 0.09 s cold and 0.3 ms cached. The bounds are 20x and over 100x that,
+    so a busy machine never misses them; they catch a conversion gone quadratic or a cache not used. The
+    start-up figures (first /odom with this much STL, cache empty and filled) are tools/bench.py's
+    ``meshes`` benchmark."""
     rng = np.random.default_rng(1)
     points = rng.random((20000, 3)) * 1000.0
     triangles = points[rng.integers(0, len(points), (40000, 3))]
@@ -543,5 +548,5 @@ def test_two_megabyte_stl_cold_and_cached(tmp_path):
     start = time.perf_counter()
     prepare(text, tmp_path)
     cached = time.perf_counter() - start
-    assert cold < 1.0, cold
+    assert cold < 2.0, cold
     assert cached < 0.05, cached

@@ -9,11 +9,11 @@ import pytest
 
 from diffbot_sim import physics
 from diffbot_sim.control.gazebo_diff_drive import DiffDriveController
-from diffbot_sim.control.kinematics import yaw_from_quaternion
 from diffbot_sim.control.odometry import EncoderOdometry
 from diffbot_sim.description import lumping
 from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.physics import World
+from diffbot_sim.transforms import yaw_from_quaternion
 
 DT = 1.0 / 240.0
 R, S, TORQUE = 0.032, 0.2, 30.0
@@ -202,11 +202,6 @@ def test_two_worlds_are_independent(make_world, seed_urdf, seed_model):
     assert first.client is None
     run(second, 0.05)  # the other world still works
     assert pose2d(b)[0] == pytest.approx(1.0, abs=2e-3)
-
-
-def test_yaw_from_quaternion_matches_pybullet():
-    for yaw in (0.0, 0.5, -2.0, 3.0):
-        assert yaw_from_quaternion(*pybullet.getQuaternionFromEuler((0.0, 0.0, yaw))) == pytest.approx(yaw, abs=1e-6)
 
 
 @pytest.mark.slow

@@ -105,19 +105,6 @@ def test_hector_imu_tags_defaults_and_heading_tags_ignored():
 
 # ---------------------------------------------------------------------------------------- maths
 
-def test_quaternions():
-    from diffbot_sim.transforms import qconj, qmul, qnormalize, rotate, rpy_quaternion
-
-    q = rpy_quaternion(0, 0, math.pi / 2)
-    assert q == pytest.approx((0, 0, math.sqrt(0.5), math.sqrt(0.5)))
-    assert rotate(q, (1, 0, 0)) == pytest.approx((0, 1, 0))
-    assert qmul(q, qconj(q)) == pytest.approx((0, 0, 0, 1))
-    q = rpy_quaternion(0.1, -0.2, 0.3)  # fixed-axis: Rz(yaw) Ry(pitch) Rx(roll)
-    composed = qmul(rpy_quaternion(0, 0, 0.3), qmul(rpy_quaternion(0, -0.2, 0), rpy_quaternion(0.1, 0, 0)))
-    assert q == pytest.approx(composed)
-    assert qnormalize((0, 0, 0, 0)) == (0.0, 0.0, 0.0, 1.0)
-
-
 def test_reading_offsets_reference_and_noise():
     st = imu.ImuSettings(rpy_offset=(0, 0, math.pi / 2))
     r = imu.Reading(st)

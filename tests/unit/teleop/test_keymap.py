@@ -3,7 +3,6 @@ import math
 
 import pytest
 
-from diffbot_sim.control.kinematics import yaw_from_quaternion
 from diffbot_sim.errors import ConfigError
 from diffbot_sim.teleop.keymap import (
     MOVE_BINDINGS,
@@ -206,13 +205,6 @@ def test_config_unknown_keys_are_reported_not_fatal():
     params = {"speed": 1.0, "sped": 2.0, "stamped": True}
     assert TeleopConfig.from_mapping(params).speed == 1.0
     assert TeleopConfig.unknown(params) == ["sped", "stamped"]
-
-
-def test_yaw_from_quaternion():
-    half = math.radians(30.0) / 2
-    assert yaw_from_quaternion(0.0, 0.0, math.sin(half), math.cos(half)) == pytest.approx(math.radians(30.0))
-    assert yaw_from_quaternion(0.0, 0.0, 0.0, 1.0) == 0.0
-    assert yaw_from_quaternion(0.0, 0.0, 1.0, 0.0) == pytest.approx(math.pi)
 
 
 def test_format_status():

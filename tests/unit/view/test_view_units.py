@@ -58,7 +58,7 @@ def test_map_walls_are_triangle_lists_with_a_limit():
 def test_marker_array_message():
     from visualization_msgs.msg import Marker
 
-    from diffbot_sim.nodes.world_markers import make_marker_array, odom_offset, robot_namespaces
+    from diffbot_sim.nodes.world_markers import make_marker_array, odom_offset
 
     array = make_marker_array(world(), "world")
     assert array.markers[0].action == Marker.DELETEALL
@@ -69,7 +69,6 @@ def test_marker_array_message():
     assert odom_offset("world", 1, 2, 0.5) == ((0, 0, 0), (0, 0, 0, 1))
     p, q = odom_offset("encoder", 1, 2, 0.5)
     assert p == (1.0, 2.0, 0.0) and q[2] == pytest.approx(math.sin(0.25))
-    assert robot_namespaces(None) == [""] and robot_namespaces(["a", {"name": "b"}]) == ["a", "b"]
 
 
 def template():

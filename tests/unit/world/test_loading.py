@@ -1,11 +1,13 @@
 """How ~world / empty_world.launch's world_name is found: as given, else in GAZEBO_RESOURCE_PATH, else in
-this package (which ships Gazebo's default worlds/empty.world)."""
+this package (which ships Gazebo's default worlds/empty.world); and how world_markers and view_rviz find a
+running simulator's world and robots from its parameters."""
 import os
 
 import pytest
 
 from diffbot_sim.errors import ModelError
-from diffbot_sim.world.loading import resolve_world_path
+from diffbot_sim.world.loading import resolve_world_path, robot_namespaces, simulator_world
+from diffbot_sim.world.map_image import synthetic_map
 from diffbot_sim.world.sdf_reader import read_world
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
@@ -38,3 +40,24 @@ def test_a_missing_world_names_itself_and_where_it_looked(monkeypatch, tmp_path)
     assert resolve_world_path(absent, ROOT) == absent
     with pytest.raises(ModelError, match="absent.world"):
         read_world(absent)
+
+
+def test_simulator_world_reads_the_simulators_world_parameter(tmp_path):
+    path = synthetic_map(str(tmp_path / "rooms.yaml"), size=60, room=30, wall=2, door=6, noise=0.0)
+    params = {"/bullet_sim/world_name": path, "/bullet_sim/map_wall_height": 0.5}
+    asked = []
+
+    def get_param(name, default):
+        asked.append(name)
+        return params.get(name, default)
+
+    world = simulator_world("/bullet_sim", get_param)
+    assert world.source == path and world.bodies  # ~world unset: empty_world.launch's world_name is read
+    assert asked == ["/bullet_sim/world", "/bullet_sim/world_name", "/bullet_sim/map_wall_height"]
+    assert {float(b.shapes[0].vertices[:, 2].max()) for b in world.bodies} == {0.5}  # map_wall_height, not 1 m
+    assert simulator_world("/other_sim", get_param) is None
+
+
+def test_robot_namespaces_from_the_robots_parameter():
+    assert robot_namespaces(None) == [""]  # the one robot of x, y, yaw
+    assert robot_namespaces(["a", {"name": "b", "x": 1.0}]) == ["a", "b"]

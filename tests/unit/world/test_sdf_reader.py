@@ -11,7 +11,7 @@ import pytest
 
 from diffbot_sim.description import mesh_formats
 from diffbot_sim.errors import ModelError
-from diffbot_sim.transforms import compose, inverse, rpy_quaternion
+from diffbot_sim.transforms import yaw_from_quaternion
 from diffbot_sim.world.model_paths import env_model_paths, ros_package_model_paths
 from diffbot_sim.world.sdf_reader import read_world
 
@@ -70,8 +70,7 @@ def same_rotation(q, r, tol=1e-9):
 
 
 def yaw(q):
-    x, y, z, w = q
-    return math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return yaw_from_quaternion(*q)
 
 
 def read(path, dirs=(), **kwargs):
@@ -101,23 +100,6 @@ TINY_DAE = """<?xml version="1.0" encoding="utf-8"?>
   <scene><instance_visual_scene url="#Scene"/></scene>
 </COLLADA>
 """
-
-
-# ------------------------------------------------------------------------------------------ pose math
-
-def test_compose_and_inverse_round_trip():
-    a = ((1.0, 2.0, 3.0), rpy_quaternion(0.1, -0.2, 0.7))
-    b = ((-0.5, 0.25, 2.0), rpy_quaternion(0.3, 0.4, -1.0))
-    back = compose(inverse(a), compose(a, b))
-    assert near(back[0], b[0]) and same_rotation(back[1], b[1])
-
-
-def test_rpy_quaternion_is_fixed_axis_roll_pitch_yaw():
-    # yaw 90 degrees turns +x into +y; roll then yaw: R = Rz Ry Rx (SDF / URDF convention)
-    q = rpy_quaternion(0, 0, math.pi / 2)
-    assert near(compose(((0, 0, 0), q), ((1, 0, 0), (0, 0, 0, 1)))[0], (0, 1, 0))
-    q = rpy_quaternion(math.pi / 2, 0, math.pi / 2)  # roll: y -> z; then yaw: unchanged z
-    assert near(compose(((0, 0, 0), q), ((0, 1, 0), (0, 0, 0, 1)))[0], (0, 0, 1))
 
 
 # ------------------------------------------------------------------------------------------ room.world
