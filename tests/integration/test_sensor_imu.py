@@ -17,7 +17,7 @@ from geometry_msgs.msg import Twist, Vector3Stamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, NavSatFix
 
-from diffbot_sim.control.kinematics import yaw_from_quaternion
+from diffbot_sim.transforms import yaw_from_quaternion
 from diffbot_sim.plugins.gps import radii
 
 SIM = "/bullet_sim"

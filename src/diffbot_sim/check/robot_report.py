@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from typing import List, Optional, Tuple
 
 from diffbot_sim import config as cfgmod
-from diffbot_sim.control import diff_drive_controller as ddc
+from diffbot_sim.control import diff_drive_config as ddc
 from diffbot_sim.control.controller_lookup import find_controllers
 from diffbot_sim.description import meshes
 from diffbot_sim.description.model_files import load_file, parse_args

@@ -9,9 +9,6 @@ Publishing odom, TF and ``cmd_vel_out`` and reading the URDF for missing geometr
 import math
 from typing import NamedTuple
 
-# The parameters' checking is diff_drive_config's; its names are passed on for callers that use the controller
-# as one module (plugins/ros_control.py, check/robot_report.py: ``ddc.ddc_config``, ``ddc.CONTROLLER_TYPE``).
-from diffbot_sim.control.diff_drive_config import CONTROLLER_TYPE, DdcConfig, ddc_config  # noqa: F401
 from diffbot_sim.control.kinematics import wheel_speeds
 from diffbot_sim.control.odometry import EncoderOdometry
 from diffbot_sim.errors import ConfigError

@@ -2,9 +2,6 @@
 
 Rim speeds are in m/s; a wheel joint's angular velocity is rim speed / wheel radius.
 """
-# Rotations live in diffbot_sim.transforms. Until plugins/ros_control.py and tests/integration/test_sensor_imu.py
-# import them from there, these two names are passed on from here (no code of their own).
-from diffbot_sim.transforms import quaternion_from_yaw, yaw_from_quaternion  # noqa: F401
 
 
 def wheel_speeds(linear, angular, separation):

@@ -187,3 +187,31 @@ class Pid:
                               i_error=self._i_error, d_error=error_dot, p_term=p_term, i_term=i_term,
                               d_term=d_term, i_max=gains.i_clamp_max, i_min=gains.i_clamp_min, output=output)
         return output
+
+
+#: Share of the stability bound an explicit loop may use before the simulator runs it as an implicit motor
+#: instead (half: the discrete loop is then not only stable but settles without ringing).
+STABILITY_MARGIN = 0.5
+
+
+def explicit_loop_margin(gains: PidGains, dt, inertia, loop):
+    """How much of its discrete stability bound a PID acting as an explicit force on ``inertia`` uses
+    (< 1 stable, <= STABILITY_MARGIN well damped), at a step of ``dt`` s.
+
+    Why: gains tuned for Gazebo's 1 ms step on tiny links (p = 300 on an OpenMANIPULATOR joint) diverge at a
+    4 ms step. With the force applied for a whole step and semi-implicit Euler integration,
+
+    * a velocity loop (``loop`` "velocity": force = P (v* - v)) is stable while ``b = P dt / I < 2``;
+    * a position loop (``loop`` "position": force = P e + D de/dt) has the characteristic polynomial
+      ``z^2 - (2 - a - b) z + (1 - b)`` with ``a = P dt^2 / I`` and ``b = D dt / I``: stable while
+      ``b < 2`` and ``a + 2 b < 4``.
+
+    Returns the larger ratio of a quantity to its bound (inf for a non-positive inertia).
+    """
+    if inertia <= 0:
+        return math.inf
+    if loop == "velocity":
+        return abs(gains.p) * dt / inertia / 2.0
+    a = abs(gains.p) * dt * dt / inertia
+    b = abs(gains.d) * dt / inertia
+    return max(b / 2.0, (a + 2.0 * b) / 4.0)

@@ -150,10 +150,29 @@ class Robot:
                                            targetVelocities=velocities, forces=max_forces,
                                            physicsClientId=self.client)
 
-    def set_positions(self, indices, positions, max_forces):
+    def set_positions(self, indices, positions, max_forces, position_gain=None):
+        """Position motors: each joint towards its target [rad or m] with at most ``max_forces`` [N·m or N].
+        ``position_gain`` (PyBullet's, default 0.1): the share of the position error the motor's velocity
+        constraint removes in one step (1: all of it, as a kinematic set would)."""
+        extra = {} if position_gain is None else {"positionGains": [position_gain] * len(indices)}
         pybullet.setJointMotorControlArray(self.body, indices, pybullet.POSITION_CONTROL,
                                            targetPositions=positions, forces=max_forces,
-                                           physicsClientId=self.client)
+                                           physicsClientId=self.client, **extra)
+
+    def joint_inertias(self, indices):
+        """Inertia [kg·m^2 or kg] each joint's motor moves (the joint-space mass matrix's diagonal at the
+        current configuration: everything beyond the joint, the rest held still), for stability checks of
+        explicit control loops."""
+        movable = sorted(self.joint_index.values())
+        positions = [s[0] for s in pybullet.getJointStates(self.body, movable, physicsClientId=self.client)]
+        matrix = pybullet.calculateMassMatrix(self.body, positions, physicsClientId=self.client)
+        offset = len(matrix) - len(movable)  # 6 base degrees of freedom first on a floating base
+        return [matrix[offset + movable.index(i)][offset + movable.index(i)] for i in indices]
+
+    def joint_limits(self, index):
+        """(lower, upper) [rad or m] PyBullet enforces on joint ``index`` (upper < lower: none)."""
+        info = pybullet.getJointInfo(self.body, index, physicsClientId=self.client)
+        return info[8], info[9]
 
     def set_efforts(self, indices, efforts):
         """Torque control; PyBullet needs the joint's velocity motor off first (``free_joints``)."""

@@ -1,14 +1,12 @@
-"""Config-level pieces of the plugins that need no ROS master: the skid-steer tags, ros_control's PID and
-controller discovery, and the model's Gazebo tag reading (both forms, bad values, dangling references)."""
+"""Config-level pieces of the plugins that need no ROS master: the skid-steer tags, controller discovery, and the model's Gazebo tag reading (both forms, bad values, dangling references)."""
 import math
 
 import pytest
 
 from diffbot_sim import config
+from diffbot_sim.control.controller_lookup import find_controllers
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.plugins import ros_control
-from diffbot_sim.plugins.ros_control import Pid
 
 PATH = "/robot/gazebo[1]/plugin[@name='skid']"
 JOINTS = ("left_front_joint", "left_rear_joint", "right_front_joint", "right_rear_joint")
@@ -80,56 +78,7 @@ def test_skid_steer_bad_joint_names_the_tag_and_the_joint(parse):
         config.skid_steer_config(parse(_four_wheels(fixed=("left_rear_joint",))), {}, PATH)
 
 
-# ---------------------------------------------------------------------------------------------------- PID
-
-def test_pid_proportional():
-    assert Pid(p=2.0).update(0.5, 0.01) == pytest.approx(1.0)
-    assert Pid(p=2.0).update(-0.25, 0.01) == pytest.approx(-0.5)
-
-
-def test_pid_integral_is_clamped_and_does_not_wind_up():
-    pid = Pid(i=10.0, i_clamp=1.5)
-    assert pid.update(1.0, 0.1) == pytest.approx(1.0)  # 10 * 0.1
-    assert pid.update(1.0, 0.1) == pytest.approx(1.5)  # 10 * 0.2 = 2.0, clamped
-    assert pid.update(1.0, 0.1) == pytest.approx(1.5)
-    # The integral was held at the clamp (0.15), so a negative error acts at once: 10 * (0.15 - 0.1).
-    assert pid.update(-1.0, 0.1) == pytest.approx(0.5)
-    assert Pid(i=10.0, i_clamp=-1.5).update(-1.0, 0.5) == pytest.approx(-1.5)  # |i_clamp|, both signs
-
-
-def test_pid_integral_without_clamp_grows():
-    pid = Pid(i=10.0)
-    for _ in range(3):
-        out = pid.update(1.0, 0.1)
-    assert out == pytest.approx(3.0)
-
-
-def test_pid_derivative_from_the_second_update():
-    pid = Pid(d=0.5)
-    assert pid.update(1.0, 0.1) == 0.0  # no previous error yet
-    assert pid.update(3.0, 0.1) == pytest.approx(0.5 * (3.0 - 1.0) / 0.1)
-    pid.reset()
-    assert pid.update(5.0, 0.1) == 0.0 and pid.integral == pytest.approx(0.5)
-
-
-def test_pid_zero_dt_is_no_output():
-    pid = Pid(p=1.0, i=1.0, d=1.0)
-    assert pid.update(1.0, 0.0) == 0.0 and pid.integral == 0.0
-
-
 # ----------------------------------------------------------------------------------------- find_controllers
-
-def _param_server(tree, monkeypatch):
-    """Make ros_control._param read ``tree`` as the parameter server (names like rospy's)."""
-    def _param(name, default):
-        node = tree
-        for part in (p for p in name.split("/") if p):
-            if not isinstance(node, dict) or part not in node:
-                return default
-            node = node[part]
-        return node
-    monkeypatch.setattr(ros_control, "get_param", _param)
-
 
 DDC = {"type": "diff_drive_controller/DiffDriveController", "left_wheel": "l", "right_wheel": "r"}
 JSC = {"type": "joint_state_controller/JointStateController", "publish_rate": 50}
@@ -145,36 +94,36 @@ PARAMS = {
 }
 
 
-def test_find_controllers_finds_nested_type_dicts_under_the_namespace(monkeypatch):
-    _param_server(PARAMS, monkeypatch)
-    found = ros_control.find_controllers("/robot")
+def test_find_controllers_finds_nested_type_dicts_under_the_namespace():
+    tree = PARAMS
+    found = find_controllers(tree, "/robot")
     assert found == {"/robot/mobile_base_controller": DDC, "/robot/arm/joint_state_controller": JSC}
 
 
-def test_find_controllers_accepts_a_relative_namespace(monkeypatch):
-    _param_server(PARAMS, monkeypatch)
-    assert set(ros_control.find_controllers("robot")) == {"/robot/mobile_base_controller",
+def test_find_controllers_accepts_a_relative_namespace():
+    tree = PARAMS
+    assert set(find_controllers(tree, "robot")) == {"/robot/mobile_base_controller",
                                                          "/robot/arm/joint_state_controller"}
 
 
-def test_find_controllers_falls_back_to_the_whole_tree(monkeypatch):
-    _param_server(PARAMS, monkeypatch)
-    found = ros_control.find_controllers("/empty")
+def test_find_controllers_falls_back_to_the_whole_tree():
+    tree = PARAMS
+    found = find_controllers(tree, "/empty")
     assert set(found) == {"/robot/mobile_base_controller", "/robot/arm/joint_state_controller",
                           "/elsewhere/other_controller"}
     assert "/robot/gazebo_ros_control/ghost" not in found
 
 
-def test_find_controllers_at_the_root(monkeypatch):
-    _param_server(PARAMS, monkeypatch)
-    assert set(ros_control.find_controllers("/")) == {"/robot/mobile_base_controller",
+def test_find_controllers_at_the_root():
+    tree = PARAMS
+    assert set(find_controllers(tree, "/")) == {"/robot/mobile_base_controller",
                                                      "/robot/arm/joint_state_controller",
                                                      "/elsewhere/other_controller"}
 
 
-def test_find_controllers_with_none_anywhere(monkeypatch):
-    _param_server({"robot": {"gazebo_ros_control": {"x": {"type": "a/b"}}}, "n": 1}, monkeypatch)
-    assert ros_control.find_controllers("/robot") == {}
+def test_find_controllers_with_none_anywhere():
+    tree = {"robot": {"gazebo_ros_control": {"x": {"type": "a/b"}}}, "n": 1}
+    assert find_controllers(tree, "/robot") == {}
 
 
 # -------------------------------------------------------------------------------------- Gazebo tag reading
