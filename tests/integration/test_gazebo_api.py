@@ -296,8 +296,39 @@ class GazeboApiTest(unittest.TestCase):
         configure = proxy("set_model_configuration", gsrv.SetModelConfiguration)
         resp = configure("bot_cfg", "", ["left_wheel_joint"], [1.0])
         self.assertTrue(resp.success, resp.status_message)
-        self.assertFalse(configure("bot_cfg", "", ["no_joint"], [1.0]).success)
+        # As upstream: names the model does not move are ignored; lists of different lengths and unknown
+        # models are refused with its messages.
+        resp = configure("bot_cfg", "", ["no_joint"], [1.0])
+        self.assertTrue(resp.success, resp.status_message)
+        resp = configure("bot_cfg", "", ["left_wheel_joint"], [1.0, 2.0])
+        self.assertFalse(resp.success)
+        self.assertIn("different lengths", resp.status_message)
+        resp = configure("no_such_model", "", [], [])
+        self.assertEqual((resp.success, resp.status_message), (False, "SetModelConfiguration: model does not exist"))
         self.delete("bot_cfg")
+
+    def test_11_a_model_with_nothing_to_collide_is_a_model(self):
+        """TurtleBot3's learning environment spawns its goal marker as a static model with one visual and no
+        collision, then waits for it in model_states and deletes it: in Gazebo it is a model like any other."""
+        marker = ('<?xml version="1.0"?><sdf version="1.6"><model name="goal"><static>true</static>'
+                  '<link name="goal"><visual name="v"><geometry><cylinder><radius>0.1</radius><length>0.05'
+                  '</length></cylinder></geometry></visual></link></model></sdf>')
+        states = []
+        sub = rospy.Subscriber("/gazebo/model_states", gmsg.ModelStates, states.append, queue_size=1)
+        try:
+            resp = self.spawn_sdf("goal_marker", marker, "robotos_name_space", pose(0.6, 0.0, 0.0), "world")
+            self.assertTrue(resp.success, resp.status_message)
+            wait(lambda: states and "goal_marker" in states[-1].name, 10.0, "the marker in model_states")
+            self.assertIn("goal_marker", self.world().model_names)
+            self.assertAlmostEqual(self.model("goal_marker").pose.position.x, 0.6, delta=1e-6)
+            moved = gmsg.ModelState(model_name="goal_marker", pose=pose(-1.0, 0.5, 0.0))
+            self.assertTrue(proxy("set_model_state", gsrv.SetModelState)(moved).success)
+            self.assertAlmostEqual(self.model("goal_marker").pose.position.y, 0.5, delta=1e-6)
+            self.assertTrue(self.delete("goal_marker").success)
+            wait(lambda: states and "goal_marker" not in states[-1].name, 10.0, "the marker gone from model_states")
+            self.assertFalse(self.delete("goal_marker").success)
+        finally:
+            sub.unregister()
 
 
 if __name__ == "__main__":

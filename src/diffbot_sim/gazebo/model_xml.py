@@ -312,3 +312,14 @@ def sdf_model_at(xml, pose):
     start, end = target.start, target.end
     shifted = (edit[0] - start, edit[1] - start, edit[2])
     return _splice(data[start:end], [shifted]).decode("utf-8")
+
+
+def sdf_model_frame(model_text):
+    """(pose ((x, y, z), (qx, qy, qz, qw)), link names) of the SDF ``<model>`` element :func:`sdf_model_at`
+    returned: for a model with nothing the physics holds, whose pose and links Gazebo still reports."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.fromstring(model_text)
+    values = [float(v) for v in (root.findtext("pose") or "0 0 0 0 0 0").split()]
+    pose = (tuple(values[:3]), rpy_quaternion(*values[3:6]))
+    return pose, [link.get("name") for link in root.findall("link") if link.get("name")]

@@ -196,6 +196,10 @@ def _ns(seconds):
     return int(round(float(seconds) * 1e9))
 
 
+class RequestError(ValueError):
+    """A /gazebo request refused with this status message (success false; the simulator goes on)."""
+
+
 class WrenchSchedule:
     """apply_body_wrench / clear_body_wrenches jobs, timed as gazebo_ros's ``wrenchBodySchedulerSlot``.
 
@@ -264,6 +268,55 @@ class WrenchSchedule:
 
     def clear_all(self):
         """Drop every job (reset_simulation/reset_world keep them upstream; this is for shutting down)."""
+        count, self._jobs = len(self._jobs), []
+        return count
+
+
+class JointEffortSchedule:
+    """apply_joint_effort / clear_joint_forces jobs, timed as gazebo_ros's ``jointEffortSchedulerSlot``.
+
+    A job: (joint, effort) from ``start`` for ``duration``; a start before now means now. Each step (at the
+    time it will reach, as :class:`WrenchSchedule`) a job applies when ``t >= start`` and (``duration < 0`` or
+    ``t <= start + duration``) and goes once ``t > start + duration``. Unlike body wrenches, joint efforts add
+    up (Gazebo's ODE joints sum SetForce calls within a step): :meth:`active` gives every active job. The
+    srv file's "duration 0: do nothing" and "shorter than a step: one step with a warning" are not what
+    upstream does, and not done here.
+    """
+
+    def __init__(self):
+        self._jobs = []  # [joint, effort, start_ns, end_ns or None]
+
+    def __len__(self):
+        return len(self._jobs)
+
+    def add(self, joint, effort, start_time, duration, now):
+        for what, value in (("effort", effort), ("start_time", start_time), ("duration", duration)):
+            if not math.isfinite(float(value)):
+                raise ValueError(f"ApplyJointEffort: {what} is {float(value)!r}")
+        start = max(_ns(start_time), _ns(now))
+        end = None if float(duration) < 0.0 else start + _ns(duration)
+        self._jobs.append([joint, float(effort), start, end])
+
+    def active(self, now):
+        """[(joint, effort)] to apply during the step that reaches ``now``; ended jobs are dropped."""
+        t = _ns(now)
+        out, keep = [], []
+        for job in self._jobs:
+            joint, effort, start, end = job
+            if t >= start and (end is None or t <= end):
+                out.append((joint, effort))
+            if end is None or t <= end:
+                keep.append(job)
+        self._jobs = keep
+        return out
+
+    def clear(self, joint):
+        """Drop every job on ``joint`` (clear_joint_forces); returns how many."""
+        before = len(self._jobs)
+        self._jobs = [job for job in self._jobs if job[0] != joint]
+        return before - len(self._jobs)
+
+    def clear_all(self):
         count, self._jobs = len(self._jobs), []
         return count
 

@@ -291,3 +291,61 @@ class Robot:
         pybullet.resetBaseVelocity(self.body, (0, 0, 0), (0, 0, 0), physicsClientId=self.client)
         for index in self.joint_index.values():
             pybullet.resetJointState(self.body, index, 0.0, 0.0, physicsClientId=self.client)
+
+    # -- grasping (gazebo_grasp_fix) ------------------------------------------------------------------------
+    def link_contacts(self, links):
+        """This step's contacts of the robot's URDF ``links`` with other bodies: [(link, other body, other link
+        index, point on the other body (world, m), force on the other body (world axes, N: normal and
+        friction))]."""
+        out = []
+        c = self.client
+        for link in links:
+            index = self.link_carrier(link)
+            for point in pybullet.getContactPoints(bodyA=self.body, linkIndexA=index, physicsClientId=c):
+                other, other_link, on_b, normal, normal_force = point[2], point[4], point[6], point[7], point[9]
+                if other == self.body:
+                    continue
+                f1, d1, f2, d2 = point[10], point[11], point[12], point[13]
+                force = tuple(-(normal_force * normal[i] + f1 * d1[i] + f2 * d2[i]) for i in range(3))
+                out.append((link, other, other_link, tuple(on_b), force))
+        return out
+
+    def attach(self, link, body, body_link=-1, collide=True):
+        """Hold ``body`` (its ``body_link``) to URDF ``link`` where it is now, by a fixed constraint; with
+        ``collide`` False the two stop colliding. Returns a handle for :meth:`detach`."""
+        c = self.client
+        index = self.link_carrier(link)
+        if index == -1:
+            frame = pybullet.getBasePositionAndOrientation(self.body, physicsClientId=c)
+        else:
+            state = pybullet.getLinkState(self.body, index, physicsClientId=c)
+            frame = (state[0], state[1])  # the link's centre-of-mass frame, which constraints use
+        if body_link == -1:
+            other = pybullet.getBasePositionAndOrientation(body, physicsClientId=c)
+        else:
+            state = pybullet.getLinkState(body, body_link, physicsClientId=c)
+            other = (state[0], state[1])
+        inverse = pybullet.invertTransform(*frame)
+        rel = pybullet.multiplyTransforms(inverse[0], inverse[1], other[0], other[1])
+        cid = pybullet.createConstraint(self.body, index, body, body_link, pybullet.JOINT_FIXED, (0, 0, 0),
+                                        rel[0], (0, 0, 0), rel[1], (0, 0, 0, 1), physicsClientId=c)
+        pybullet.changeConstraint(cid, maxForce=1e4, physicsClientId=c)
+        if not collide:
+            for i in range(-1, pybullet.getNumJoints(self.body, physicsClientId=c)):
+                pybullet.setCollisionFilterPair(self.body, body, i, body_link, 0, physicsClientId=c)
+        return cid, body, body_link, collide
+
+    def detach(self, handle):
+        """Undo :meth:`attach` (collisions back on)."""
+        cid, body, body_link, collide = handle
+        c = self.client
+        pybullet.removeConstraint(cid, physicsClientId=c)
+        if not collide:
+            for i in range(-1, pybullet.getNumJoints(self.body, physicsClientId=c)):
+                pybullet.setCollisionFilterPair(self.body, body, i, body_link, 1, physicsClientId=c)
+
+    def body_origin(self, body, link=-1):
+        """World position of another body's link frame origin (its centre of mass for PyBullet's base)."""
+        if link == -1:
+            return tuple(pybullet.getBasePositionAndOrientation(body, physicsClientId=self.client)[0])
+        return tuple(pybullet.getLinkState(body, link, physicsClientId=self.client)[4])

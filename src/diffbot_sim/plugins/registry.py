@@ -8,9 +8,11 @@ from diffbot_sim.errors import PluginNotLoaded
 from diffbot_sim.plugins import (
     diff_drive,
     gps,
+    grasp_fix,
     imu,
     joint_state,
     kobuki,
+    mimic_joint,
     p3d,
     planar_move,
     ray_clouds,
@@ -34,6 +36,9 @@ MODEL_PLUGINS = {
     "libhector_gazebo_ros_imu.so": imu.create_hector,
     "libgazebo_ros_p3d.so": p3d.create,
     "libhector_gazebo_ros_gps.so": gps.create,
+    "libgazebo_grasp_fix.so": grasp_fix.create,
+    "libroboticsgroup_gazebo_mimic_joint_plugin.so": mimic_joint.create,
+    "libroboticsgroup_upatras_gazebo_mimic_joint_plugin.so": mimic_joint.create,
 }
 #: Sensor plugins by filename: ``create(ctx, sensor, plugin_element, params)`` with ``sensor`` a
 #: :class:`~diffbot_sim.description.plugin_tags.SensorElement` (its type, link, element and path). One line per module.
@@ -92,6 +97,9 @@ def build(ctx, found, params):
     rest = [t for t in ctx.model.transmissions if t.joint not in owned]
     if rest:
         plugins.append(JointMotors(ctx, rest))
+    mimics = mimic_joint.urdf_mimics(ctx, {p.cfg.mimic_joint for p in plugins if isinstance(p, mimic_joint.MimicJoint)})
+    if mimics is not None:
+        plugins.append(mimics)
     if ctx.cfg.publish_ground_truth:
         base = next((p.drive.robot_base_frame for p in plugins if isinstance(p, diff_drive.DiffDrive)),
                     ctx.frame(ctx.model.root))

@@ -27,7 +27,9 @@ from diffbot_sim.description import meshes
 from diffbot_sim.description.model_files import package_path
 from diffbot_sim.errors import DiffbotSimError
 from diffbot_sim.gazebo import model_xml, world_api
+from diffbot_sim.gazebo.world_api import RequestError
 from diffbot_sim.plugins.base import close_handle, publisher
+from diffbot_sim.simulator.joint_services import JointServices
 from diffbot_sim.transforms import compose, inverse
 
 #: Time a spawn may take on the loop (mesh conversion of a large model), before the caller gives up.
@@ -55,10 +57,6 @@ def _twist_msg(twist):
     (msg.linear.x, msg.linear.y, msg.linear.z) = twist[0]
     (msg.angular.x, msg.angular.y, msg.angular.z) = twist[1]
     return msg
-
-
-class RequestError(ValueError):
-    """A request refused with this status message (the simulator goes on)."""
 
 
 class _Robot:
@@ -134,6 +132,35 @@ class _WorldModel:
         return self._find(link)[0], -1
 
 
+class _GhostModel:
+    """A model with nothing for the physics to hold (only visuals, or links without collisions: a goal marker):
+    Gazebo keeps it as a model like any other, so it has a pose (set by set_model_state, back to its spawn
+    pose on reset_world), is listed in model_states and can be deleted; nothing collides with it."""
+
+    static = True
+
+    def __init__(self, name, pose, links):
+        self.name, self.spawn_pose, self.pose = name, pose, pose
+        self.link_names = list(links) or ["link"]
+
+    def links(self):
+        return list(self.link_names)
+
+    def motion(self, link=None):
+        if link is not None and link not in self.link_names:
+            raise KeyError(link)
+        return self.pose, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+
+    def set_motion(self, pose, linear, angular, link=None):
+        self.pose = pose
+
+    def reset(self):
+        self.pose = self.spawn_pose
+
+    def body_of(self, link):
+        raise RequestError(f"model '{self.name}' has no body to push (nothing in it collides)")
+
+
 class GazeboApi:
     """The /gazebo services and topics. ``spawn_urdf(name, urdf_text, source, pose)`` builds a robot on the
     loop (every plugin, sensor and controller it would get at start) and returns its RobotRuntime."""
@@ -148,6 +175,8 @@ class GazeboApi:
         self.model_states_pub = publisher(self.ns + "/model_states", gmsg.ModelStates)
         self.link_states_pub = publisher(self.ns + "/link_states", gmsg.LinkStates)
         self.handles = []
+        self.joints = JointServices(self)
+        self.ghosts = {}  # name -> _GhostModel: spawned models without bodies
         self._models = None  # {name: entity}, built on first use and again after a spawn or a delete
 
     # -- the loop's side (called on its thread, like a plugin) --------------------------------------
@@ -161,7 +190,9 @@ class GazeboApi:
         return math.inf
 
     def before_step(self, now):
-        """Wrenches due during the coming step (Gazebo's scheduler runs at the time the step reaches)."""
+        """Wrenches and joint efforts due during the coming step (Gazebo's schedulers run at the time the step
+        reaches)."""
+        self.joints.before_step(now)
         if not len(self.wrenches):
             return
         for body, force, torque, point in self.wrenches.active(now + self.cfg.time_step):
@@ -208,9 +239,15 @@ class GazeboApi:
         for uid, body in self.sim.world.world_bodies:
             out.setdefault(body.top_model, []).append((uid, body))
         models = {name: _WorldModel(name, bodies, self.sim.world) for name, bodies in out.items()}
+        models.update(self.ghosts)
         for runtime in self.sim.robots:
             models[runtime.name] = _Robot(runtime)
         return models
+
+    def reset(self):
+        """reset_world / reset_simulation: models without bodies go back to their spawn poses too."""
+        for ghost in self.ghosts.values():
+            ghost.reset()
 
     def _model(self, name, what="model"):
         entity = self.models().get(name)
@@ -262,6 +299,7 @@ class GazeboApi:
         service("set_model_configuration", gsrv.SetModelConfiguration, self._set_configuration)
         service("apply_body_wrench", gsrv.ApplyBodyWrench, self._apply_wrench)
         service("clear_body_wrenches", gsrv.BodyRequest, self._clear_wrenches)
+        self.joints.advertise(service)
         for name, action in (("pause_physics", self.sim.pause), ("unpause_physics", self.sim.unpause),
                              ("reset_simulation", self.sim.reset_simulation), ("reset_world", self.sim.reset_world)):
             service(name, Empty, lambda _req, action=action: self.sim.empty_service(action))
@@ -314,7 +352,9 @@ class GazeboApi:
             return f"SpawnModel: Successfully spawned entity '{runtime.name}'"
         text = model_xml.inject_robot_namespace(req.model_xml, namespace)
         text = model_xml.rename_model(text, "sdf", name)
-        count = self._spawn_sdf(name, text, pose)
+        count, links, placed_pose = self._spawn_sdf(name, text, pose)
+        if count == 0:
+            self.ghosts[name] = _GhostModel(name, placed_pose, links)
         return f"SpawnModel: Successfully spawned entity '{name}' ({count} bodies)"
 
     def _spawn_sdf(self, name, text, pose):
@@ -330,7 +370,9 @@ class GazeboApi:
         for text in world.warnings + [f"not simulated: {'; '.join(world.not_simulated)}"] * bool(world.not_simulated):
             rospy.logwarn(f"spawned model {name}: {text}")
         world.has_ground = False  # a spawned plane does not replace the ground
-        return self.sim.world.load_world(world, meshes.default_cache_dir())
+        count = self.sim.world.load_world(world, meshes.default_cache_dir())
+        frame, links = model_xml.sdf_model_frame(placed)
+        return count, links, frame
 
     def _delete(self, req):
         response = gsrv.DeleteModelResponse()
@@ -339,6 +381,8 @@ class GazeboApi:
             entity = self._model(req.model_name)
             if isinstance(entity, _Robot):
                 self.sim.remove_robot(entity.runtime)
+            elif isinstance(entity, _GhostModel):
+                del self.ghosts[req.model_name]
             else:
                 for uid, _ in entity.bodies:
                     self.sim.world.remove_body(uid)
@@ -485,20 +529,27 @@ class GazeboApi:
         return self._run(action, gsrv.SetPhysicsPropertiesResponse())
 
     def _set_configuration(self, req):
+        """SetModelConfiguration as upstream: unknown model or lists of different lengths refused; names the
+        model does not move are ignored; positions clamped to the joints' limits (Gazebo's SetPosition);
+        the robot's joints at rest there. Controllers keep their commands: a trajectory controller holding
+        its start pose drives the joints back, as in Gazebo (gazebo_ros_pkgs #93), unless paused until they
+        start (spawn_model -J ... -unpause)."""
         def action():
-            entity = self._model(req.model_name, "SetModelConfiguration: model")
-            if not isinstance(entity, _Robot):
-                raise RequestError(f"SetModelConfiguration: model '{req.model_name}' has no joints")
+            entity = self.models().get(req.model_name)
+            if entity is None:
+                raise RequestError("SetModelConfiguration: model does not exist")
             if len(req.joint_names) != len(req.joint_positions):
-                raise RequestError("SetModelConfiguration: joint_names and joint_positions differ in length")
+                raise RequestError("SetModelConfiguration: joint name and position list have different lengths")
+            if not isinstance(entity, _Robot):
+                return "SetModelConfiguration: success"
             robot = entity.robot
+            names, positions = [], []
             for joint, position in zip(req.joint_names, req.joint_positions):
-                if joint not in robot.joint_index:
-                    raise RequestError(f"SetModelConfiguration: joint '{joint}' is not a moving joint of "
-                                       f"'{req.model_name}'")
-                if not math.isfinite(position):
-                    raise RequestError(f"SetModelConfiguration: joint '{joint}' position is {position}")
-            robot.set_joint_positions(robot.indices(list(req.joint_names)), list(req.joint_positions))
+                if joint in robot.joint_index and math.isfinite(position):
+                    lower, upper = robot.joint_limits(robot.joint_index[joint])
+                    names.append(joint)
+                    positions.append(min(max(position, lower), upper) if lower <= upper else position)
+            robot.set_joint_positions(robot.indices(names), positions)
             entity.runtime.ctx.sim.world.lift_out(robot)
             return "SetModelConfiguration: success"
         return self._run(action, gsrv.SetModelConfigurationResponse())

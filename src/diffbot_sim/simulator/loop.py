@@ -227,6 +227,7 @@ class Simulator:
             runtime.start(now)
         if self.api is not None:
             self.api.wrenches.clear_all()
+            self.api.reset()
 
     def reset_simulation(self):
         """gazebo_ros reset_simulation: as reset_world, and sim time back to 0 (/clock jumps back, as in
