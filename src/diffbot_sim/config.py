@@ -29,6 +29,9 @@ class SimConfig:
     real_time: bool = True  # pace sim time to the wall clock; false: as fast as possible
     real_time_factor: float = 1.0  # sim seconds per wall second when real_time
     fast_batch: float = 0.005  # s (wall); fast mode sends messages in bursts this often; 0: one write each
+    wait_for_nodes: bool = True  # fast mode: after each sensor message, hold sim time until its subscribers answered
+    wait_for_nodes_timeout: float = 5.0  # s (wall); a node that holds the simulator longer is not waited for
+    wait_for_nodes_ignore: List[str] = field(default_factory=lambda: ["/rviz*", "/rqt*"])  # caller-id patterns
     send_timeout: float = 0.5  # s (wall); a subscriber that takes no data for this long is disconnected
     clock_rate: float = 100.0  # Hz of /clock, in sim time
     cmd_vel_timeout: float = 0.0  # s; 0 holds the last command (Gazebo); > 0 brakes on stale commands
@@ -183,13 +186,19 @@ def sim_config(params):
     cfg.gazebo_namespace = "/" + check_string(name("gazebo_namespace"), cfg.gazebo_namespace).strip("/")
     cfg.physics_engine = check_string(name("physics_engine"), cfg.physics_engine, allow_empty=True)
     for key in ("gui", "real_time", "debug_cmd_applied", "publish_ground_truth", "paused",
-                "autostart_controllers", "enable_ros_network"):
+                "autostart_controllers", "enable_ros_network", "wait_for_nodes"):
         setattr(cfg, key, check_bool(name(key), getattr(cfg, key)))
     cfg.time_step = check_number(name("time_step"), cfg.time_step, low=1e-5, high=0.05)
     cfg.real_time_factor = check_number(name("real_time_factor"), cfg.real_time_factor, low=1e-3)
     cfg.clock_rate = check_number(name("clock_rate"), cfg.clock_rate, low=1e-3)
     cfg.fast_batch = check_number(name("fast_batch"), cfg.fast_batch, low=0.0, high=0.1)
     cfg.send_timeout = check_number(name("send_timeout"), cfg.send_timeout, low=0.01)
+    cfg.wait_for_nodes_timeout = check_number(name("wait_for_nodes_timeout"), cfg.wait_for_nodes_timeout, low=0.0)
+    if isinstance(cfg.wait_for_nodes_ignore, str):
+        cfg.wait_for_nodes_ignore = cfg.wait_for_nodes_ignore.split()
+    if not isinstance(cfg.wait_for_nodes_ignore, list) or not all(isinstance(v, str)
+                                                                    for v in cfg.wait_for_nodes_ignore):
+        raise ConfigError(name("wait_for_nodes_ignore"), cfg.wait_for_nodes_ignore, "a list of node name patterns")
     cfg.cmd_vel_timeout = check_number(name("cmd_vel_timeout"), cfg.cmd_vel_timeout, low=0.0)
     cfg.max_wheel_velocity = check_number(name("max_wheel_velocity"), cfg.max_wheel_velocity, low=0.0)
     for key in ("gravity", "x", "y", "z", "yaw"):

@@ -166,6 +166,8 @@ class Plugin:
 
     #: The plugin's filename (or a descriptive name for built-in ones), for reports.
     filename = ""
+    #: Its publications are sensor data that nodes in the loop answer (``~wait_for_nodes`` waits after them).
+    sensor = False
 
     def joints(self):
         """Joints this plugin commands (a joint has one owner)."""

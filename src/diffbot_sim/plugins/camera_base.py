@@ -14,6 +14,8 @@ def choose_renderer(ctx):
 class CameraBase(Plugin):
     """What the camera and depth plugins share: the sensor's pose, timing, rendering and CameraInfo."""
 
+    sensor = True
+
     def __init__(self, ctx, sensor, cfg, tags):
         self.ctx = ctx
         self.sensor = sensor

@@ -47,6 +47,8 @@ def ros1_namespace(ctx, values):
 class RaySensorPlugin(Plugin):
     """A ray sensor mounted on a robot link: schedule, pose and casting; subclasses publish."""
 
+    sensor = True
+
     def __init__(self, ctx, sensor, plugin_element, path):
         self.ctx = ctx
         self.path = path

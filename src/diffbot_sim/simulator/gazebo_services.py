@@ -178,6 +178,7 @@ class GazeboApi:
         self.joints = JointServices(self)
         self.ghosts = {}  # name -> _GhostModel: spawned models without bodies
         self._models = None  # {name: entity}, built on first use and again after a spawn or a delete
+        self._changed = False  # a spawn or delete since model_states was last published
 
     # -- the loop's side (called on its thread, like a plugin) --------------------------------------
     def publishers(self):
@@ -205,16 +206,8 @@ class GazeboApi:
             self.sim.world.apply_wrench(uid, index, force, torque, point)
 
     def after_step(self, now, stamp):
-        models = None
-        if self.model_states_pub.get_num_connections():
-            models = self.models()
-            msg = gmsg.ModelStates()
-            for name, entity in models.items():
-                pose, linear, angular = entity.motion()
-                msg.name.append(name)
-                msg.pose.append(_pose_msg(pose))
-                msg.twist.append(_twist_msg((linear, angular)))
-            self.model_states_pub.publish(msg)
+        self._changed = False
+        models = self._publish_model_states() if self.model_states_pub.get_num_connections() else None
         if self.link_states_pub.get_num_connections():
             models = models or self.models()
             msg = gmsg.LinkStates()
@@ -225,6 +218,24 @@ class GazeboApi:
                     msg.pose.append(_pose_msg(pose))
                     msg.twist.append(_twist_msg((linear, angular)))
             self.link_states_pub.publish(msg)
+
+    def publish_if_changed(self, now, stamp):
+        """While sim time is held (``~wait_for_nodes``), a spawn or delete is published in model_states at once:
+        clients that wait for their model to appear (or go) there would otherwise wait for ever."""
+        if self._changed and self.model_states_pub.get_num_connections():
+            self._publish_model_states()
+        self._changed = False
+
+    def _publish_model_states(self):
+        models = self.models()
+        msg = gmsg.ModelStates()
+        for name, entity in models.items():
+            pose, linear, angular = entity.motion()
+            msg.name.append(name)
+            msg.pose.append(_pose_msg(pose))
+            msg.twist.append(_twist_msg((linear, angular)))
+        self.model_states_pub.publish(msg)
+        return models
 
     # -- models ------------------------------------------------------------------------------------
     def models(self):
@@ -331,6 +342,7 @@ class GazeboApi:
             return self._spawn_checked(req, service_kind)
         finally:
             self._models = None  # a robot or bodies may have joined
+            self._changed = True
 
     def _spawn_checked(self, req, service_kind):
         name = req.model_name
@@ -387,6 +399,7 @@ class GazeboApi:
                 for uid, _ in entity.bodies:
                     self.sim.world.remove_body(uid)
             self._models = None
+            self._changed = True
             self.wrenches.clear_model(req.model_name)
             return f"DeleteModel: successfully deleted model '{req.model_name}'"
         return self._run(action, response)

@@ -14,7 +14,11 @@ from tf2_msgs.msg import TFMessage
 from diffbot_sim.physics import World
 from diffbot_sim.plugins.base import next_due, publisher
 from diffbot_sim.ros import messages as ros_msgs
+from diffbot_sim.simulator.sync import NodeSync
 from diffbot_sim.simulator.throttle import Throttle
+
+#: Wall seconds between two reports of the achieved real-time factor in fast mode.
+RTF_REPORT_PERIOD = 30.0
 
 
 class SubscriberLinks:
@@ -159,6 +163,9 @@ class Simulator:
         self.links = SubscriberLinks(self.publishers, cfg.send_timeout, 0.0 if cfg.real_time else cfg.fast_batch)
         self.api = None  # the /gazebo world API (nodes.gazebo_api), when ~enable_ros_network
         self.paused = cfg.paused
+        self.sync = NodeSync(cfg.wait_for_nodes_timeout, cfg.wait_for_nodes_ignore, rospy.get_name(), self.warn)
+        self._sensor_pubs = None  # the sensor plugins' publishers (NodeSync), rebuilt when robots change
+        self._rtf_mark = None  # (wall, sim, waited) at the last achieved-RTF report
 
     def publishers(self):
         """Every publisher the loop writes to (SubscriberLinks tunes and batches their connections)."""
@@ -242,6 +249,7 @@ class Simulator:
     def add_robot(self, runtime, now=None):
         """A robot joins the loop; one spawned while running starts at the current sim time."""
         self.robots.append(runtime)
+        self._sensor_pubs = None
         if now is not None:
             runtime.start(now)
             self._next_publish = min(self._next_publish, now)
@@ -249,6 +257,7 @@ class Simulator:
     def remove_robot(self, runtime):
         """delete_model: the robot's topics, services and body go."""
         self.robots.remove(runtime)
+        self._sensor_pubs = None
         runtime.close()
         self.world.remove_robot(runtime.ctx.robot)
 
@@ -348,11 +357,49 @@ class Simulator:
             self.tf_pub.publish(self._tf_msg)
         if self.api is not None:
             self.api.after_step(now, stamp)
-        if now + 1e-9 >= self.next_clock:
+        ticked = now + 1e-9 >= self.next_clock
+        if ticked:
             self._publish_clock(now)
+        if not self.cfg.real_time and self.cfg.wait_for_nodes:
+            self._wait_for_nodes(ticked)
         self._next_publish = min([self.next_clock] + [r.next_publish() for r in self.robots]
                                  + ([self.api.next_publish()] if self.api is not None else []))
         self.links.release_if_due(wall)
+
+    def _wait_for_nodes(self, ticked):
+        """Fast mode: hold sim time until the nodes fed by this step's sensor messages answered them, and
+        after a /clock tick until the nodes in the loop are idle (:mod:`diffbot_sim.simulator.sync`)."""
+        if self._sensor_pubs is None:
+            self._sensor_pubs = [pub for runtime in self.robots for plugin in runtime.plugins if plugin.sensor
+                                 for pub in plugin.publishers()]
+        fresh = self.sync.published(self._sensor_pubs)
+        if fresh or (ticked and self.sync.listeners):
+            self.links.release()
+            self.sync.forget_drops(fresh)
+            self.sync.wait(fresh, self._serve_while_held, lambda: self.paused or rospy.is_shutdown())
+        self._report_rtf()
+
+    def _serve_while_held(self):
+        """Requests keep being served while sim time is held (a reset, a spawn, a step-and-wait client's
+        services); a change of the model set is published at once (clients watch model_states for it)."""
+        self._handle_requests()
+        if self.api is not None:
+            self.api.publish_if_changed(self.sim_time, self.stamp())
+
+    def _report_rtf(self):
+        wall = time.monotonic()
+        if self._rtf_mark is None:
+            self._rtf_mark = (wall, self.sim_time, self.sync.waited)
+            return
+        wall0, sim0, waited0 = self._rtf_mark
+        if wall - wall0 < RTF_REPORT_PERIOD:
+            return
+        rtf = (self.sim_time - sim0) / (wall - wall0)
+        held = (self.sync.waited - waited0) / (wall - wall0)
+        rospy.set_param("~achieved_rtf", round(rtf, 3))
+        rospy.loginfo(f"bullet_sim: fast mode, real-time factor {rtf:.1f} over the last {wall - wall0:.0f} s "
+                      f"(waiting for the nodes in the loop {100 * held:.0f} % of the time)")
+        self._rtf_mark = (wall, self.sim_time, self.sync.waited)
 
     def stamp(self):
         """Sim time as a rospy.Time, via integer nanoseconds (cheaper than Time.from_sec's float path)."""

@@ -1,0 +1,115 @@
+#!/usr/bin/env python3
+"""loop_lockstep suite: a step-and-wait client as Gazebo learning environments are written (TurtleBot3's
+machine-learning chapter): ``step`` publishes cmd_vel, then ``rospy.wait_for_message('scan')`` (a subscriber made
+and dropped every step), then computes; ``reset`` calls /gazebo/reset_simulation; a goal marker (a static model
+with one visual, no collision) is spawned and deleted, the client busy-waiting on model_states for it.
+
+At real time each action is held one scan period (the next scan after the command). In fast mode with
+``~wait_for_nodes`` the simulator must give exactly that, however long the client computes: judged by the
+scans' stamps (every step 0.2 s of sim time after the last) and by the body (ground truth: the robot turned
+as one step of the command says), at well above real time.
+"""
+import math
+import os
+import sys
+import time
+import unittest
+
+import numpy as np
+import rospy
+import rostest
+from gazebo_msgs.msg import ModelStates
+from gazebo_msgs.srv import DeleteModel, SpawnModel
+from geometry_msgs.msg import Pose, Twist
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import LaserScan
+from std_srvs.srv import Empty
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from simtest import Latest, wait_for  # noqa: E402
+
+SCAN_PERIOD = 0.2  # s: laser_robot.urdf's 5 Hz laser
+STEPS = 30
+MARKER = ('<?xml version="1.0"?><sdf version="1.6"><model name="goal"><static>true</static><link name="goal">'
+          '<visual name="v"><geometry><cylinder><radius>0.1</radius><length>0.05</length></cylinder></geometry>'
+          '</visual></link></model></sdf>')
+
+
+def compute(seconds):
+    """The agent's work between steps: CPU, not sleep (a network's forward pass)."""
+    end = time.monotonic() + seconds
+    a = np.ones((64, 64))
+    while time.monotonic() < end:
+        a = np.tanh(a @ a.T * 1e-3)
+
+
+class Lockstep(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_lockstep")
+        cls.cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=5)
+        cls.truth = Latest("/bullet_sim/ground_truth", Odometry)
+        cls.states = Latest("/gazebo/model_states", ModelStates)
+        for name in ("reset_simulation", "spawn_sdf_model", "delete_model"):
+            rospy.wait_for_service(f"/gazebo/{name}", 30)
+        cls.reset = rospy.ServiceProxy("/gazebo/reset_simulation", Empty)
+        cls.spawn = rospy.ServiceProxy("/gazebo/spawn_sdf_model", SpawnModel)
+        cls.delete = rospy.ServiceProxy("/gazebo/delete_model", DeleteModel)
+        wait_for(lambda: cls.cmd.get_num_connections() > 0, 30, "bullet_sim subscribed to /cmd_vel")
+
+    def step(self, angular, work, linear=0.0):
+        twist = Twist()
+        twist.linear.x, twist.angular.z = linear, angular
+        self.cmd.publish(twist)
+        scan = rospy.wait_for_message("/scan", LaserScan, timeout=30)
+        compute(work)
+        return scan.header.stamp.to_sec()
+
+    def test_1_each_action_is_held_one_scan_period(self):
+        self.reset()
+        first = rospy.wait_for_message("/scan", LaserScan, timeout=30).header.stamp.to_sec()
+        stamps, started = [first], time.monotonic()
+        for k in range(STEPS):
+            stamps.append(self.step(0.5 if k % 2 == 0 else -0.5, 0.005 + 0.01 * (k % 3)))
+        wall = time.monotonic() - started
+        gaps = np.diff(stamps)
+        print(f"FIGURE lockstep: {STEPS} steps in {wall:.2f} s wall ({STEPS / wall:.1f} steps/s, "
+              f"{(stamps[-1] - stamps[0]) / wall:.1f}x real time); sim time per step {gaps.min():.3f}-"
+              f"{gaps.max():.3f} s", flush=True)
+        self.assertTrue(np.allclose(gaps, SCAN_PERIOD, atol=1e-6),
+                        f"sim time between the scans of two steps {np.round(gaps, 4).tolist()} (each should be "
+                        f"one scan period, {SCAN_PERIOD} s)")
+        self.assertGreater((stamps[-1] - stamps[0]) / wall, 1.5, "lockstep ran no faster than real time")
+
+    def test_2_the_body_moves_one_period_per_step(self):
+        """Ten steps of 0.2 m/s, then two of 0: the body (ground truth) moved 10 periods' worth, 0.4 m, less what
+        starting from rest costs (measured at real time: 0.37 m); held longer per step, it goes further (0.67 m
+        without ~wait_for_nodes)."""
+        self.reset()
+        rospy.wait_for_message("/scan", LaserScan, timeout=30)
+        wait_for(lambda: self.truth.get() is not None, 10, "ground truth")
+        start = self.truth.get().pose.pose.position
+        for _ in range(10):
+            self.step(0.0, 0.03, linear=0.2)
+        self.step(0.0, 0.0)
+        self.step(0.0, 0.0)
+        end = self.truth.get().pose.pose.position
+        moved = math.hypot(end.x - start.x, end.y - start.y)
+        self.assertAlmostEqual(moved, 0.37, delta=0.03, msg=f"the body moved {moved:.3f} m in 10 steps of 0.2 m/s")
+
+    def test_3_goal_marker_spawned_and_deleted_while_held(self):
+        """respawnGoal's pattern: spawn, busy-wait until model_states lists it, delete, busy-wait until gone."""
+        for _ in range(3):
+            self.assertTrue(self.spawn("goal", MARKER, "robotos_name_space", Pose(), "world").success)
+            deadline = time.monotonic() + 20
+            while "goal" not in (self.states.get().name if self.states.get() else []):  # busy, as the original
+                self.assertLess(time.monotonic(), deadline, "the goal never appeared in model_states")
+            self.step(0.0, 0.01)
+            self.assertTrue(self.delete("goal").success)
+            deadline = time.monotonic() + 20
+            while "goal" in (self.states.get().name if self.states.get() else ["goal"]):
+                self.assertLess(time.monotonic(), deadline, "the goal never left model_states")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("diffbot_sim", "loop_lockstep", Lockstep, sys.argv)
