@@ -29,8 +29,14 @@ from diffbot_sim.errors import DiffbotSimError
 from diffbot_sim.gazebo import model_xml, world_api
 from diffbot_sim.gazebo.world_api import RequestError
 from diffbot_sim.plugins.base import close_handle, publisher
+from diffbot_sim.simulator.gazebo_models import (
+    ActorModelEntity,
+    GhostModelEntity,
+    RobotModelEntity,
+    WorldModelEntity,
+)
 from diffbot_sim.simulator.joint_services import JointServices
-from diffbot_sim.transforms import compose, inverse
+from diffbot_sim.transforms import compose
 
 #: Time a spawn may take on the loop (mesh conversion of a large model), before the caller gives up.
 SPAWN_TIMEOUT = 60.0
@@ -59,108 +65,6 @@ def _twist_msg(twist):
     return msg
 
 
-class _Robot:
-    """A robot as a Gazebo model: its root link is the model frame."""
-
-    static = False
-
-    def __init__(self, runtime):
-        self.runtime = runtime
-        self.name = runtime.name
-        self.robot = runtime.ctx.robot
-        self.model = runtime.ctx.model
-
-    def links(self):
-        """The links Gazebo keeps: the root and every child of a moving joint (fixed-joint children are
-        lumped into their parent, as Gazebo's URDF reader does); lumped links still answer ``motion``."""
-        return [self.model.root] + [j.child for j in self.model.joints.values() if j.type != "fixed"]
-
-    def motion(self, link=None):
-        """(pose, linear, angular) of a link frame (the root: the model), world axes."""
-        return self.robot.link_motion(link or self.model.root)
-
-    def set_motion(self, pose, linear, angular, link=None):
-        if link not in (None, self.model.root):
-            raise RequestError(f"link '{self.name}::{link}' is not the model's canonical link "
-                               f"'{self.model.root}': only a whole model can be moved here")
-        self.robot.set_base_motion(pose, linear, angular)
-        self.runtime.ctx.sim.world.lift_out(self.robot)
-
-    def body_of(self, link):
-        return self.robot.body, self.robot.link_carrier(link)
-
-
-class _WorldModel:
-    """A top-level model of the world file: its links are separate bodies moved together."""
-
-    def __init__(self, name, bodies, world):
-        self.name, self.bodies, self.world = name, bodies, world  # bodies: [(uid, world.Body)]
-        self.static = all(body.static for _, body in bodies)
-
-    def links(self):
-        return [body.name.split("::")[-1] for _, body in self.bodies]
-
-    def _find(self, link):
-        if link is None:
-            return self.bodies[0]
-        for uid, body in self.bodies:
-            if body.name.split("::")[-1] == link:
-                return uid, body
-        raise KeyError(link)
-
-    def motion(self, link=None):
-        uid, body = self._find(link)
-        pose, linear, angular = self.world.body_motion(uid, body.inertial_pose)
-        if link is None:  # the model frame, carried by its first link
-            pose = compose(pose, inverse(self._in_model(body)))
-        return pose, linear, angular
-
-    @staticmethod
-    def _in_model(body):
-        return compose(inverse(body.model_pose), body.pose)
-
-    def set_motion(self, pose, linear, angular, link=None):
-        if link is not None:
-            uid, body = self._find(link)
-            self.world.set_body_motion(uid, body.inertial_pose, pose, linear, angular)
-            return
-        for uid, body in self.bodies:
-            self.world.set_body_motion(uid, body.inertial_pose, compose(pose, self._in_model(body)),
-                                       linear, angular)
-
-    def body_of(self, link):
-        return self._find(link)[0], -1
-
-
-class _GhostModel:
-    """A model with nothing for the physics to hold (only visuals, or links without collisions: a goal marker):
-    Gazebo keeps it as a model like any other, so it has a pose (set by set_model_state, back to its spawn
-    pose on reset_world), is listed in model_states and can be deleted; nothing collides with it."""
-
-    static = True
-
-    def __init__(self, name, pose, links):
-        self.name, self.spawn_pose, self.pose = name, pose, pose
-        self.link_names = list(links) or ["link"]
-
-    def links(self):
-        return list(self.link_names)
-
-    def motion(self, link=None):
-        if link is not None and link not in self.link_names:
-            raise KeyError(link)
-        return self.pose, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
-
-    def set_motion(self, pose, linear, angular, link=None):
-        self.pose = pose
-
-    def reset(self):
-        self.pose = self.spawn_pose
-
-    def body_of(self, link):
-        raise RequestError(f"model '{self.name}' has no body to push (nothing in it collides)")
-
-
 class GazeboApi:
     """The /gazebo services and topics. ``spawn_urdf(name, urdf_text, source, pose)`` builds a robot on the
     loop (every plugin, sensor and controller it would get at start) and returns its RobotRuntime."""
@@ -176,7 +80,7 @@ class GazeboApi:
         self.link_states_pub = publisher(self.ns + "/link_states", gmsg.LinkStates)
         self.handles = []
         self.joints = JointServices(self)
-        self.ghosts = {}  # name -> _GhostModel: spawned models without bodies
+        self.ghosts = {}  # name -> GhostModelEntity: spawned models without bodies
         self._models = None  # {name: entity}, built on first use and again after a spawn or a delete
         self._changed = False  # a spawn or delete since model_states was last published
 
@@ -249,10 +153,12 @@ class GazeboApi:
         out = {}
         for uid, body in self.sim.world.world_bodies:
             out.setdefault(body.top_model, []).append((uid, body))
-        models = {name: _WorldModel(name, bodies, self.sim.world) for name, bodies in out.items()}
+        models = {name: WorldModelEntity(name, bodies, self.sim.world) for name, bodies in out.items()}
         models.update(self.ghosts)
+        for actor in self.sim.actors.actors if self.sim.actors is not None else ():
+            models[actor.name] = ActorModelEntity(actor)
         for runtime in self.sim.robots:
-            models[runtime.name] = _Robot(runtime)
+            models[runtime.name] = RobotModelEntity(runtime)
         return models
 
     def reset(self):
@@ -366,7 +272,7 @@ class GazeboApi:
         text = model_xml.rename_model(text, "sdf", name)
         count, links, placed_pose = self._spawn_sdf(name, text, pose)
         if count == 0:
-            self.ghosts[name] = _GhostModel(name, placed_pose, links)
+            self.ghosts[name] = GhostModelEntity(name, placed_pose, links)
         return f"SpawnModel: Successfully spawned entity '{name}' ({count} bodies)"
 
     def _spawn_sdf(self, name, text, pose):
@@ -391,9 +297,9 @@ class GazeboApi:
 
         def action():
             entity = self._model(req.model_name)
-            if isinstance(entity, _Robot):
+            if isinstance(entity, RobotModelEntity):
                 self.sim.remove_robot(entity.runtime)
-            elif isinstance(entity, _GhostModel):
+            elif isinstance(entity, GhostModelEntity):
                 del self.ghosts[req.model_name]
             else:
                 for uid, _ in entity.bodies:
@@ -500,7 +406,7 @@ class GazeboApi:
             response.parent_model_name = ""
             response.body_names = entity.links()
             response.canonical_body_name = response.body_names[0] if response.body_names else ""
-            if isinstance(entity, _Robot):
+            if isinstance(entity, RobotModelEntity):
                 model = entity.model
                 response.canonical_body_name = model.root
                 response.joint_names = [j.name for j in model.joints.values() if j.type != "fixed"]
@@ -553,7 +459,7 @@ class GazeboApi:
                 raise RequestError("SetModelConfiguration: model does not exist")
             if len(req.joint_names) != len(req.joint_positions):
                 raise RequestError("SetModelConfiguration: joint name and position list have different lengths")
-            if not isinstance(entity, _Robot):
+            if not isinstance(entity, RobotModelEntity):
                 return "SetModelConfiguration: success"
             robot = entity.robot
             names, positions = [], []

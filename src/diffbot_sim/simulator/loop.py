@@ -163,6 +163,7 @@ class Simulator:
         self.links = SubscriberLinks(self.publishers, cfg.send_timeout, 0.0 if cfg.real_time else cfg.fast_batch)
         self.api = None  # the /gazebo world API (nodes.gazebo_api), when ~enable_ros_network
         self.paused = cfg.paused
+        self.actors = None  # the world's <actor>s (simulator.actors.Actors), when it has any
         self.sync = NodeSync(cfg.wait_for_nodes_timeout, cfg.wait_for_nodes_ignore, rospy.get_name(), self.warn)
         self._sensor_pubs = None  # the sensor plugins' publishers (NodeSync), rebuilt when robots change
         self._rtf_mark = None  # (wall, sim, waited) at the last achieved-RTF report
@@ -235,6 +236,8 @@ class Simulator:
         if self.api is not None:
             self.api.wrenches.clear_all()
             self.api.reset()
+        if self.actors is not None:
+            self.actors.reset(now)
 
     def reset_simulation(self):
         """gazebo_ros reset_simulation: as reset_world, and sim time back to 0 (/clock jumps back, as in
@@ -336,6 +339,8 @@ class Simulator:
         now = self.sim_time
         for runtime in self.robots:
             runtime.before_step(now)
+        if self.actors is not None:
+            self.actors.before_step(now)
         if self.api is not None:
             self.api.before_step(now)
         self.world.step()

@@ -13,6 +13,7 @@ from diffbot_sim.description.urdf_model import parse_urdf, tag_value
 from diffbot_sim.errors import ModelError
 from diffbot_sim.plugins import registry
 from diffbot_sim.plugins.base import RobotContext, get_param
+from diffbot_sim.simulator.actors import Actors
 from diffbot_sim.simulator.loop import RobotRuntime, Simulator
 from diffbot_sim.world.loading import load_world
 
@@ -130,6 +131,9 @@ def build(cfg, params):
         if world is not None:
             sim.world_description = world
             sim.world.load_world(world, meshes.default_cache_dir())
+            if world.actors:
+                sim.actors = Actors(sim.world, world.actors, cfg.seed, lambda: sim.robots)
+                world.warnings.extend(sim.actors.notes)
         loaded = [_build_robot(sim, cfg, spec, params) for spec in specs]
     except BaseException:
         sim.close()

@@ -79,3 +79,4 @@ class WorldDescription:
     not_simulated: List[str] = field(default_factory=list)
     warnings: List[str] = field(default_factory=list)
     has_ground: bool = False  # a ground plane is among the bodies (else the simulator adds its own)
+    actors: List[object] = field(default_factory=list)  # world.actor_script.ActorDescription, in file order

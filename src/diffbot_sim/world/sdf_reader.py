@@ -32,6 +32,7 @@ import os
 
 from diffbot_sim.errors import ModelError
 from diffbot_sim.transforms import compose, inverse
+from diffbot_sim.world.actor_script import read_actor
 from diffbot_sim.world.bodies import IDENTITY, Body, WorldDescription
 from diffbot_sim.world.model_paths import env_model_paths
 from diffbot_sim.world.sdf_elements import ElementReader, sdf_bool, text_of
@@ -143,7 +144,9 @@ class _Reader:
                 self.skip(f"light {el.get('name', '')} ({el.get('type', 'point')})")
             elif tag == "plugin":
                 self.skip(f"plugin {el.get('filename', el.get('name', ''))} in world")
-            elif tag in ("actor", "road", "population"):
+            elif tag == "actor":
+                self.actor(el, src, f"{wpath}/actor[@name='{el.get('name')}']")
+            elif tag in ("road", "population"):
                 self.skip(f"{tag} {el.get('name', '')}")
             elif tag in _WORLD_NOT_SIMULATED:
                 self.skip(tag)
@@ -198,6 +201,18 @@ class _Reader:
         if gravity_el is not None:
             self.world.gravity = self.values.floats(gravity_el.text, 3, src, f"{wpath}/gravity", "<gravity>")
 
+    def actor(self, el, src, path):
+        """A Gazebo ``<actor>``: read as Gazebo 11 reads it (:mod:`diffbot_sim.world.actor_script`); its
+        numbers leniently, each oddity one warning."""
+        notes = []
+        actor = read_actor(el, f"{src.path}: {path}", notes)
+        for note in notes:
+            self.warn(note)
+        if any(a.name == actor.name for a in self.world.actors) or actor.name in self.scope.models:
+            self.warn(f"{src.path}: {path}: a second model or actor named '{actor.name}'; skipped")
+            return
+        self.world.actors.append(actor)
+
     # -- models
     def include(self, el, parent, src, path):
         uri = text_of(el, "uri")
@@ -221,7 +236,14 @@ class _Reader:
             self.skip(f"light {name or top.get('name', '')} ({top.get('type', 'point')})")
             return None
         if top.tag == "actor":
-            self.skip(f"actor {name or top.get('name', '')}")
+            if name:
+                top.set("name", name)
+            pose_el = el.find("pose")
+            if pose_el is not None:
+                for old in top.findall("pose"):
+                    top.remove(old)
+                top.insert(0, pose_el)
+            self.actor(top, isrc, f"{path}/actor[@name='{top.get('name')}']")
             return None
         pose = None
         if el.find("pose") is not None:

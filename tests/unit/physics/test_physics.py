@@ -2,7 +2,6 @@
 casters, reset, independent worlds. Every test gets fresh worlds, closed by the fixture; runs are short."""
 import math
 import os
-import xml.etree.ElementTree as ET
 
 import pybullet
 import pytest

@@ -1,5 +1,4 @@
 """Config-level pieces of the plugins that need no ROS master: the skid-steer tags, controller discovery, and the model's Gazebo tag reading (both forms, bad values, dangling references)."""
-import math
 
 import pytest
 

@@ -726,9 +726,10 @@ def test_physics_gravity_and_not_simulated_once(tmp_path):
         <sensor name="lidar" type="ray"/></link></model>""")
     world = read(path, [])
     assert world.gravity == (0, 0, -3.7) and world.max_step_size == 0.004 and world.real_time_factor == 2
+    assert [a.name for a in world.actors] == ["walker"]  # an actor is simulated (simulator.actors)
     assert world.not_simulated == [
         "light lamp (point)", "light spot1 (spot)", "scene", "gui", "atmosphere", "magnetic_field",
-        "spherical_coordinates", "wind", "audio", "actor walker", "road street", "population cans",
+        "spherical_coordinates", "wind", "audio", "road street", "population cans",
         "plugin libworld_thing.so in world", "plugin libdrive.so in model robot",
         "sensor lidar (ray) in link robot::l", "physics profile slow",
         "physics type bullet (Bullet is used whatever the file says)", "physics max_contacts",
@@ -783,3 +784,22 @@ def test_missing_file_and_missing_world(tmp_path):
     path = write(tmp_path / "robot.world", "<robot name='r'/>")
     with pytest.raises(ModelError, match="root element is <robot>"):
         read(path, [])
+
+
+def test_actors_of_the_world_and_of_includes(tmp_path):
+    """<actor> at world level and through <include> (its <name> and <pose> replace the file's): read as
+    world.actor_script reads them; a second model or actor of one name is one warning."""
+    models = tmp_path / "models"
+    model_dir(models, "person", '<sdf version="1.6"><actor name="someone"><pose>9 9 0 0 0 0</pose><script>'
+              '<trajectory id="0" type="walking"><waypoint><time>0</time><pose>0 0 0 0 0 0</pose></waypoint>'
+              '<waypoint><time>2</time><pose>1 0 0 0 0 0</pose></waypoint></trajectory></script></actor></sdf>')
+    path = world_file(tmp_path, f"""
+      <actor name="a1"><script><trajectory id="0" type="walk"><waypoint><time>0</time><pose>1 2 0 0 0 0</pose>
+        </waypoint></trajectory></script></actor>
+      <include><uri>model://person</uri><name>visitor</name><pose>3 4 0 0 0 1</pose></include>
+      <actor name="a1"/>""")
+    world = read(path, [str(models)])
+    assert [a.name for a in world.actors] == ["a1", "visitor"]
+    assert world.actors[1].pose == (3.0, 4.0, 0.0, 0.0, 0.0, 1.0)
+    assert world.actors[1].script.trajectories[0].duration == 2.0
+    assert any("a second model or actor named 'a1'" in w for w in world.warnings)
