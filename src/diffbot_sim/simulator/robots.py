@@ -100,15 +100,25 @@ def _read_world(cfg):
     return load_world(cfg.world, cfg.map_wall_height) if cfg.world else None
 
 
-def _apply_world_physics(cfg, world, params):
-    """A world's gravity and real_time_factor apply unless the node's parameters set them; its step does
-    not (ours is the measured one; ``~time_step`` chooses another)."""
+def apply_world_physics(cfg, world, params):
+    """A world's gravity and pace apply unless the node's parameters set them; its step does not (ours is the
+    measured one; ``~time_step`` chooses another).
+
+    The pace is Gazebo's: ``real_time_update_rate`` 0 runs as fast as the nodes in the loop allow (fast mode,
+    ``~wait_for_nodes``); a rate r paces sim time to r x ``max_step_size`` (default 0.001 s) times the wall
+    clock; without a rate, ``real_time_factor`` is taken as that factor."""
     if "gravity" not in params and world.gravity is not None:
         cfg.gravity = world.gravity[2]
         if abs(world.gravity[0]) > 1e-9 or abs(world.gravity[1]) > 1e-9:
             world.not_simulated.append(f"horizontal gravity {world.gravity[:2]} (only its z is simulated)")
-    if "real_time_factor" not in params and world.real_time_factor:
-        cfg.real_time_factor = world.real_time_factor
+    rate = world.real_time_update_rate
+    if rate is not None and "real_time" not in params:
+        cfg.real_time = rate > 0
+    if "real_time_factor" not in params:
+        if rate:
+            cfg.real_time_factor = rate * (world.max_step_size or 0.001)
+        elif world.real_time_factor:
+            cfg.real_time_factor = world.real_time_factor
     if world.max_step_size:
         world.not_simulated.append(f"physics max_step_size {world.max_step_size:g} s (the step is ~time_step, "
                                    f"{cfg.time_step:g} s)")
@@ -120,7 +130,7 @@ def build(cfg, params):
     specs = cfgmod.robot_specs(cfg, params)
     world = _read_world(cfg)
     if world is not None:
-        _apply_world_physics(cfg, world, params)
+        apply_world_physics(cfg, world, params)
     sim = Simulator(cfg)
     try:
         if cfg.renderer == "egl":  # before any body exists: the EGL plugin draws only bodies made after it

@@ -75,6 +75,7 @@ class WorldDescription:
     bodies: List[Body] = field(default_factory=list)
     gravity: Vec3 = (0.0, 0.0, -9.8)
     real_time_factor: Optional[float] = None
+    real_time_update_rate: Optional[float] = None  # Hz of world updates; 0: as fast as possible
     max_step_size: Optional[float] = None
     not_simulated: List[str] = field(default_factory=list)
     warnings: List[str] = field(default_factory=list)

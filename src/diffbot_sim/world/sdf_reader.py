@@ -19,7 +19,7 @@ What is read (SDF 1.4 to 1.9, as Gazebo 11 reads them):
   ``placement_frame``, 1.9 ``degrees`` and ``rotation_format="quat_xyzw"``.
 * The first ``<state>``: its model (and nested model and link) poses replace the file's, as Gazebo's
   ``World::SetState`` does at start; its ``insertions`` add models and its ``deletions`` remove them.
-* ``<physics>`` gravity, ``max_step_size`` and ``real_time_factor``.
+* ``<physics>`` gravity, ``max_step_size``, ``real_time_factor`` and ``real_time_update_rate``.
 
 ``model://NAME`` is searched as Gazebo does: ``~/.gazebo/models``, each ``GAZEBO_MODEL_PATH`` entry, then the
 directories ROS packages export to gazebo_ros (:func:`ros_package_model_paths`); the first match wins.
@@ -186,6 +186,9 @@ class _Reader:
                     self.world.max_step_size = self.values.number(chosen, "max_step_size", None, src, ppath, True)
                 elif child.tag == "real_time_factor":
                     self.world.real_time_factor = self.values.number(chosen, "real_time_factor", None, src, ppath)
+                elif child.tag == "real_time_update_rate":
+                    self.world.real_time_update_rate = self.values.number(chosen, "real_time_update_rate", None,
+                                                                          src, ppath)
                 elif child.tag == "gravity":
                     if src.version >= (1, 6):
                         self.warn(f"{src.path}: {ppath}/gravity: SDF 1.6 moved gravity to <world>; ignored")

@@ -129,7 +129,7 @@ def test_room_world_layout_state_and_model_uri():
     assert all(body.static for name, body in b.items() if name != "pushable_box::link")
     assert world.max_step_size == 0.001 and world.real_time_factor == 1.0 and world.gravity == (0, 0, -9.8)
     assert "light sun (directional)" in world.not_simulated
-    assert "physics real_time_update_rate" in world.not_simulated
+    assert world.real_time_update_rate == 1000.0  # with the 1 ms step: real time (simulator.robots)
 
 
 def test_room_ring_mesh_is_a_hollow_hexagon():
@@ -203,8 +203,9 @@ def test_turtlebot3_style_world(tmp_path):
     assert near(obstacle.pose[0], (-1, 1, 0.125))
     assert world.gravity == (0, 0, -9.81)  # 1.4: gravity lives in <physics>
     assert world.has_ground and world.max_step_size == 0.001 and world.real_time_factor == 1.0
+    assert world.real_time_update_rate == 1000.0
     for item in ("light sun (directional)", "plugin libobstacle_2.so in model obstacle_2", "scene", "gui",
-                 "physics real_time_update_rate", "physics ode/solver", "physics ode/constraints"):
+                 "physics ode/solver", "physics ode/constraints"):
         assert item in world.not_simulated
     assert len(world.not_simulated) == len(set(world.not_simulated))
     assert world.warnings == []
