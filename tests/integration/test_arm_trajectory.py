@@ -1,0 +1,155 @@
+#!/usr/bin/env python3
+"""arm_trajectory suite: the mobile manipulator's position JointTrajectoryController (gazebo_ros_control
+POSITION_PID joints), driven as MoveIt or a user's script drives it, judged by the body.
+
+- A goal reaches its target and SUCCEEDS; every link is where joint_states + the URDF put it (ground truth from
+  /gazebo/get_link_state), and the arm holds still under gravity afterwards.
+- A new goal preempts a running one (PREEMPTED, then SUCCEEDED at the new target); a cancel holds the arm.
+- The command topic and query_state work; the state topic carries desired/actual/error.
+- Bad goals get upstream's answer (or a refusal where upstream would follow nonsense) and nothing moves.
+- The base still drives (/cmd_vel, ground truth).
+"""
+import math
+import os
+import sys
+import unittest
+
+import rospy
+import rostest
+from actionlib_msgs.msg import GoalStatus
+from control_msgs.msg import FollowJointTrajectoryResult as Result
+from control_msgs.msg import JointTrajectoryControllerState
+from control_msgs.srv import QueryTrajectoryState
+from controller_manager_msgs.srv import ListControllers
+from geometry_msgs.msg import Twist
+from trajectory_msgs.msg import JointTrajectory
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from armtest import Arm, close, trajectory  # noqa: E402
+from simtest import Latest, wait_for  # noqa: E402
+
+JOINTS = ["shoulder_yaw_joint", "shoulder_pitch_joint", "elbow_joint", "wrist_joint"]
+HOME = [0.0, 0.0, 0.0, 0.0]
+REACH = [0.6, 0.5, 0.9, 0.4]
+MODEL = "diffbot_arm"
+
+
+class ArmTrajectory(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_arm_trajectory")
+        rospy.wait_for_service("/controller_manager/list_controllers", 60)
+        cls.list = rospy.ServiceProxy("/controller_manager/list_controllers", ListControllers)
+        wait_for(lambda: {c.name for c in cls.list().controller if c.state == "running"} >=
+                 {"arm_controller", "gripper_controller", "joint_state_controller"}, 60,
+                 "the spawner to start the controllers")
+        cls.arm = Arm("/arm_controller", MODEL)
+        cls.state = Latest("/arm_controller/state", JointTrajectoryControllerState)
+        cls.command = rospy.Publisher("/arm_controller/command", JointTrajectory, queue_size=1)
+
+    def go_home(self):
+        state, _ = self.arm.run(trajectory(JOINTS, (1.5, HOME)))
+        self.assertEqual(state, GoalStatus.SUCCEEDED)
+
+    def test_1_goal_reached_and_the_body_agrees(self):
+        t0 = rospy.get_time()
+        state, result = self.arm.run(trajectory(JOINTS, (1.0, [0.3, 0.2, 0.4, 0.1]), (2.0, REACH)))
+        took = rospy.get_time() - t0
+        self.assertEqual((state, result.error_code), (GoalStatus.SUCCEEDED, Result.SUCCESSFUL), result.error_string)
+        self.assertLess(took, 2.0 + 1.0 + 0.5, "the goal ended long after its last point and goal_time")
+        self.assertTrue(close(self.arm.states.fresh() and self.arm.states.get(JOINTS), REACH, 0.03),
+                        f"joints at {self.arm.states.get(JOINTS)}, goal {REACH}")
+        self.arm.assert_body_agrees(self)
+        # holds under gravity: the forearm stays put for 2 s of sim time
+        before = self.arm.world_pose("forearm_link")[0]
+        start = rospy.get_time()
+        wait_for(lambda: rospy.get_time() - start > 2.0, 30, "2 s of sim time")
+        after = self.arm.world_pose("forearm_link")[0]
+        self.assertLess(math.dist(before, after), 0.003, "the arm sagged or drifted while holding")
+
+    def test_2_preempted_by_a_new_goal_then_cancel_holds(self):
+        self.go_home()
+        self.arm.client.send_goal(self.arm.goal(trajectory(JOINTS, (4.0, REACH))))
+        start = rospy.get_time()
+        wait_for(lambda: rospy.get_time() - start > 1.0, 30, "1 s into the first goal")
+        first = self.arm.client.gh  # the first goal's handle, to read its end state
+        state, result = self.arm.run(trajectory(JOINTS, (1.5, [-0.4, 0.3, 0.3, 0.0])))
+        self.assertEqual(state, GoalStatus.SUCCEEDED)
+        self.assertEqual(first.get_goal_status(), GoalStatus.PREEMPTED)
+        self.assertTrue(close(self.arm.states.fresh() and self.arm.states.get(JOINTS), [-0.4, 0.3, 0.3, 0.0], 0.03))
+        # cancel half-way: PREEMPTED, and the arm stops where it is
+        self.arm.client.send_goal(self.arm.goal(trajectory(JOINTS, (3.0, REACH))))
+        start = rospy.get_time()
+        wait_for(lambda: rospy.get_time() - start > 1.0, 30, "1 s into the goal")
+        self.arm.client.cancel_goal()
+        wait_for(lambda: self.arm.client.get_state() == GoalStatus.PREEMPTED, 10, "the goal PREEMPTED")
+        start = rospy.get_time()
+        wait_for(lambda: rospy.get_time() - start > 0.5, 30, "0.5 s")
+        stopped = self.arm.states.fresh() and self.arm.states.get(JOINTS)
+        start = rospy.get_time()
+        wait_for(lambda: rospy.get_time() - start > 1.0, 30, "1 s")
+        later = self.arm.states.fresh() and self.arm.states.get(JOINTS)
+        self.assertTrue(close(later, stopped, 0.03), f"the arm moved on after the cancel: {stopped} -> {later}")
+        self.assertFalse(close(later, REACH, 0.05), "the cancelled goal was completed anyway")
+
+    def test_3_command_topic_state_topic_and_query_state(self):
+        self.go_home()
+        target = [0.2, 0.4, 0.6, -0.2]
+        self.command.publish(trajectory(JOINTS, (1.0, target)))
+        wait_for(lambda: close(self.arm.states.get(JOINTS), target, 0.03), 30, "the command topic's target")
+        msg = wait_for(lambda: self.state.get(), 10, "/arm_controller/state")
+        self.assertEqual(list(msg.joint_names), JOINTS)
+        self.assertTrue(close(msg.desired.positions, target, 1e-6))
+        self.assertTrue(close(msg.actual.positions, target, 0.03))
+        query = rospy.ServiceProxy("/arm_controller/query_state", QueryTrajectoryState)
+        answer = query(rospy.Time.from_sec(rospy.get_time() + 1.0))
+        self.assertEqual(list(answer.name), JOINTS)
+        self.assertTrue(close(answer.position, target, 1e-6))
+
+    def test_4_bad_goals_get_upstreams_answer_and_nothing_moves(self):
+        self.go_home()
+        wait_for(self.arm.at_rest, 20, "the arm at rest")
+        before = self.arm.states.fresh() and self.arm.states.get(JOINTS)
+        cases = [
+            ("NaN", trajectory(JOINTS, (1.0, [0.1, float("nan"), 0.0, 0.0])), Result.INVALID_GOAL),
+            ("Inf", trajectory(JOINTS, (1.0, [0.1, 0.0, float("inf"), 0.0])), Result.INVALID_GOAL),
+            ("unknown joint", trajectory(JOINTS[:3] + ["no_such_joint"], (1.0, [0.1] * 4)), Result.INVALID_JOINTS),
+            ("duplicate joint", trajectory(JOINTS[:3] + [JOINTS[0]], (1.0, [0.1] * 4)), Result.INVALID_JOINTS),
+            ("missing joint", trajectory(JOINTS[:3], (1.0, [0.1] * 3)), Result.INVALID_JOINTS),
+            ("times not increasing", trajectory(JOINTS, (1.0, [0.1] * 4), (1.0, [0.2] * 4)), Result.INVALID_GOAL),
+            ("outside the limits", trajectory(JOINTS, (1.0, [0.1, 9.0, 0.0, 0.0])), Result.INVALID_GOAL),
+        ]
+        for what, msg, code in cases:
+            state, result = self.arm.run(msg)
+            self.assertEqual(state, GoalStatus.REJECTED, what)
+            self.assertEqual(result.error_code, code, f"{what}: {result.error_string}")
+        self.assertIn("not strictly increasing", self.arm.run(cases[5][1])[1].error_string)
+        state, result = self.arm.run(trajectory(JOINTS))  # empty: upstream holds and succeeds
+        self.assertEqual(state, GoalStatus.SUCCEEDED)
+        after = self.arm.states.fresh() and self.arm.states.get(JOINTS)
+        self.assertTrue(close(after, before, 0.02), f"a refused goal moved the arm: {before} -> {after}")
+
+    def test_5_the_base_still_drives(self):
+        """0.2 m/s forward until the body has gone 0.3 m (ground truth), level at its rest height."""
+        base = self.arm.world_pose(self.arm.model.root)[0]
+        cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
+        wait_for(lambda: cmd.get_num_connections() > 0, 10, "bullet_sim subscribed to /cmd_vel")
+        twist = Twist()
+        twist.linear.x = 0.2
+        start = rospy.get_time()
+
+        def moved():
+            cmd.publish(twist)
+            return math.dist(base[:2], self.arm.world_pose(self.arm.model.root)[0][:2]) > 0.3
+        try:
+            wait_for(moved, 60, "the base to drive 0.3 m", poll=0.05)
+        finally:
+            cmd.publish(Twist())
+        took = rospy.get_time() - start
+        self.assertLess(took, 0.3 / 0.2 + 1.0, f"0.3 m at 0.2 m/s took {took:.2f} s of sim time")
+        self.assertLess(abs(self.arm.world_pose(self.arm.model.root)[0][2] - base[2]), 0.01,
+                        "the base left its rest height")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("diffbot_sim", "arm_trajectory", ArmTrajectory, sys.argv)
