@@ -41,7 +41,8 @@ class SubscriberLinks:
         self.send_timeout = send_timeout
         self.batch = batch
         self.held_since = None
-        self._tuned = set()
+        self._tuned = set()  # the live sockets, as of the last scan (every 0.1 s at most)
+        self._corked = []  # the sockets corked by the open batch
         self._next_scan = 0.0
 
     def _sockets(self):
@@ -67,17 +68,20 @@ class SubscriberLinks:
                     pass  # closing under us: rospy drops it on its next write
         self._tuned = live
 
-    def _cork(self, value):
-        for sock in self._sockets():
+    @staticmethod
+    def _cork(sockets, value):
+        for sock in sockets:
             try:
                 sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_CORK, value)
             except OSError:
                 pass
 
     def hold(self, now_wall):
-        """Fast mode, before publishing: start a batch unless one is open."""
+        """Fast mode, before publishing: start a batch unless one is open (on the sockets of the last scan: a
+        connection newer than that is written at once, as in real time)."""
         if self.batch > 0 and self.held_since is None:
-            self._cork(1)
+            self._corked = list(self._tuned)
+            self._cork(self._corked, 1)
             self.held_since = now_wall
 
     def release_if_due(self, now_wall):
@@ -87,7 +91,8 @@ class SubscriberLinks:
     def release(self):
         """Send everything held now (also before the loop pauses, and at close)."""
         if self.held_since is not None:
-            self._cork(0)
+            self._cork(self._corked, 0)
+            self._corked = []
             self.held_since = None
 
 
