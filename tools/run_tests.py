@@ -183,7 +183,15 @@ def _skip_reason(name):
 
 
 NAV_FIXTURES = os.path.join(ROOT, "tests", "data", "nav_way")
+#: A Gazebo user's mobile-manipulator packages (their own launch files, YAML and URDF) the arm suites launch.
+MANIPULATOR_FIXTURES = os.path.join(ROOT, "tests", "data", "manipulator_way")
 NAV_NEEDS = ("move_base", "amcl", "map_server", "gmapping", "dwa_local_planner")
+
+
+def add_package_path(directory):
+    """Let rospack find the fixture packages under ``directory`` (ROS_PACKAGE_PATH of every process started)."""
+    os.environ["ROS_PACKAGE_PATH"] = os.pathsep.join(
+        [p for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p] + [directory])
 
 
 def run_nav(args):
@@ -197,8 +205,7 @@ def run_nav(args):
         say("0 passed, 1 failed")
         return 1
     # The Gazebo user's own packages (fakebot_gazebo, _slam, _navigation) that nav_gazebo_way_* launch.
-    os.environ["ROS_PACKAGE_PATH"] = os.pathsep.join(
-        [p for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p] + [NAV_FIXTURES])
+    add_package_path(NAV_FIXTURES)
     suites = sorted(glob.glob(os.path.join(ROOT, "tests", "integration", "nav_*.test")))
     if args.only:
         suites = [t for t in suites if args.only in os.path.basename(t)]
@@ -265,6 +272,7 @@ def main():
     if args.nav:
         return run_nav(args)
     os.makedirs(RESULTS, exist_ok=True)
+    add_package_path(MANIPULATOR_FIXTURES)
     total_p = total_f = total_s = 0
     failures = []
     if args.only is None:

@@ -57,7 +57,7 @@ def trajectory(joints, *points, stamp=None):
 class Arm:
     """One trajectory controller's action client and the robot's body."""
 
-    def __init__(self, controller, model_name, description="/robot_description"):
+    def __init__(self, controller, model_name, description="/robot_description", joint_states="/joint_states"):
         self.client = actionlib.SimpleActionClient(f"{controller}/follow_joint_trajectory",
                                                    FollowJointTrajectoryAction)
         assert self.client.wait_for_server(rospy.Duration(60)), f"no action server {controller}"
@@ -65,7 +65,7 @@ class Arm:
         self.model = parse_urdf(rospy.get_param(description))
         rospy.wait_for_service("/gazebo/get_link_state", 30)
         self.link_state = rospy.ServiceProxy("/gazebo/get_link_state", GetLinkState)
-        self.states = JointStates()
+        self.states = JointStates(joint_states)
 
     def goal(self, msg, goal_tolerance=(), path_tolerance=(), goal_time=0.0):
         goal = FollowJointTrajectoryGoal(trajectory=msg)
