@@ -64,6 +64,29 @@ class Controller:
             raise ModelError(f"controller {self.name} needs joint '{joint}' with a {interface} transmission "
                              f"({found})", self.ctx.model.source)
 
+    def substitute_unstable(self, joints, gains, loop, mode="position", force=None):
+        """Joints of ``joints`` whose controller PID (``gains``, one per joint) is no well-damped explicit loop
+        at our step (gains tuned for Gazebo's 1 ms step on light links): each is handed to PyBullet's
+        ``mode`` motor within the effort limit (or ``force``), with one warning naming it, and returned: the
+        controller then writes its desired positions to them instead of efforts."""
+        from diffbot_sim.control.pid import STABILITY_MARGIN
+
+        out = set()
+        for joint, joint_gains in zip(joints, gains):
+            if joint_gains is None:
+                continue
+            margin, inertia = self.hw.explicit_margin(joint, joint_gains, loop)
+            if margin > STABILITY_MARGIN:
+                self.hw.drive_by_targets(joint, mode, force)
+                self.ctx.warnings.append(
+                    f"{self.name}: gains of {joint} (p={joint_gains.p:g}, d={joint_gains.d:g}) are "
+                    f"{'an unstable' if margin >= 1 else 'a ringing'} explicit loop at a "
+                    f"{self.ctx.cfg.time_step * 1000:.2f} ms step on this joint (it moves {inertia:.3g}, "
+                    f"{margin:.2g} of the stability bound); the joint follows the controller's desired "
+                    f"{mode} through PyBullet's motor within its effort limit instead")
+                out.add(joint)
+        return out
+
     def urdf_joints(self):
         """URDF joints as the controllers' configs take them: name -> (type, lower, upper)."""
         return {name: (j.type, j.lower, j.upper) for name, j in self.ctx.model.joints.items()}

@@ -26,6 +26,11 @@ class GripperActionController(Controller):
         self.core = gac.GripperActionCore(self.cfg)
         #: the effort variant closes a PID loop in software: it runs every physics step (Gazebo's default)
         self.closed_loop = self.cfg.variant == "effort"
+        # an effort gripper whose PID cannot run explicitly here squeezes through PyBullet's position motor,
+        # capped at the goal's max_effort: the same grip force, the same stall
+        self.by_position = bool(self.substitute_unstable([self.cfg.joint], [self.cfg.gains], "position",
+                                                         force=abs(self.cfg.max_effort))
+                                if self.closed_loop and self.cfg.gains else ())
         self.goals = {}
         self.server = self.own(action_server(join(name, "gripper_cmd"), msg.GripperCommandAction, self._on_goal,
                                              self._on_cancel))
@@ -68,7 +73,7 @@ class GripperActionController(Controller):
     def start(self, now):
         super().start(now)
         self.core.starting(now, self.hw.positions([self.cfg.joint])[0])
-        self.hw.set_command(self.cfg.joint, self.core.command_position if self.cfg.variant == "position" else 0.0)
+        self._write(self.core.command_position if self.cfg.variant == "position" or self.by_position else 0.0)
 
     def stop(self, now):
         super().stop(now)
@@ -77,7 +82,7 @@ class GripperActionController(Controller):
     def update(self, now, period, stamp, transforms):
         joint = self.cfg.joint
         result = self.core.update(now, period, self.hw.positions([joint])[0], self.hw.velocities([joint])[0])
-        self.hw.set_command(joint, result.command)
+        self._write(self.core.command_position if self.by_position else result.command)
         for event in result.events:
             handle = self.goals.pop(event.goal_id, None)
             if handle is None:
@@ -86,6 +91,11 @@ class GripperActionController(Controller):
                 handle.set_succeeded(cm.gripper_result(event.result))
             else:
                 handle.set_aborted(cm.gripper_result(event.result))
+
+    def _write(self, value):
+        if self.by_position:
+            self.hw.set_target_force(self.cfg.joint, abs(self.core.command_max_effort))
+        self.hw.set_command(self.cfg.joint, value)
 
     def summary(self):
         return {f"{self.name}/action": join(self.name, "gripper_cmd")}

@@ -64,6 +64,10 @@ class SimJoint:
     effort: float = 0.0
     frozen: Optional[float] = None  # e-stop: the position held
     pushed: object = None  # the last motor setting given to PyBullet (skipped when unchanged)
+    #: a controller whose own PID is unstable on this joint hands it targets instead of efforts: "position" or
+    #: "velocity", driven by PyBullet's motor with at most ``target_force`` (None: the effort limit)
+    target_mode: Optional[str] = None
+    target_force: Optional[float] = None
 
     @property
     def motor_force(self):
@@ -73,7 +77,7 @@ class SimJoint:
     @property
     def torque_driven(self):
         """Driven by a torque set every step (effort joints, explicit PIDs)."""
-        return self.method == EFFORT or self.pid is not None
+        return self.target_mode is None and (self.method == EFFORT or self.pid is not None)
 
 
 class RobotHWSim:
@@ -148,6 +152,22 @@ class RobotHWSim:
         """A controller's command (rad, m, rad/s, m/s, N·m or N, per the joint's interface)."""
         self.joints[joint].command = value
 
+    def explicit_margin(self, joint, gains, loop):
+        """How much of its stability bound a controller's PID (``gains``, on ``loop`` "position" or
+        "velocity") uses as an explicit force on ``joint`` at our step (see ``_check_stability``)."""
+        inertia = self.ctx.robot.joint_inertias([self.joints[joint].index])[0]
+        return explicit_loop_margin(gains, self.ctx.cfg.time_step, inertia, loop), inertia
+
+    def drive_by_targets(self, joint, mode, force=None):
+        """From now on ``set_command`` on ``joint`` gives a ``mode`` ("position" or "velocity") target that
+        PyBullet's motor holds within ``force`` (default: the effort limit): for a controller whose own PID
+        cannot run explicitly at our step."""
+        sim_joint = self.joints[joint]
+        sim_joint.target_mode, sim_joint.target_force, sim_joint.pushed = mode, force, None
+
+    def set_target_force(self, joint, force):
+        self.joints[joint].target_force = force
+
     def positions(self, names):
         return [self.joints[n].position for n in names]
 
@@ -173,7 +193,7 @@ class RobotHWSim:
             else:
                 joint.position += shortest_angular_distance(joint.position, raw)
             joint.velocity = velocity
-            if joint.implicit:
+            if joint.implicit or joint.target_mode is not None:
                 joint.effort = torque
             elif not joint.torque_driven:
                 joint.effort = 0.0
@@ -199,6 +219,15 @@ class RobotHWSim:
             position = raw if joint.position is None or joint.joint_type == "prismatic" else \
                 joint.position + shortest_angular_distance(joint.position, raw)
             command = self._command(joint)
+            if joint.target_mode is not None:
+                force = joint.motor_force if joint.target_force is None else joint.target_force
+                if joint.target_mode == "position":
+                    self._push(joint, ("p", command, force),
+                               lambda: robot.set_positions([joint.index], [command], [force]))
+                else:
+                    self._push(joint, ("v", command, force),
+                               lambda: robot.set_velocities([joint.index], [command], [force]))
+                continue
             if joint.limit_handle is not None:
                 command = joint.limit_handle.enforce(command, position, velocity, dt)
             if joint.torque_driven:
@@ -220,7 +249,7 @@ class RobotHWSim:
     def _command(self, joint):
         if not self.estop:
             return joint.command
-        if joint.method in (POSITION, POSITION_PID):
+        if joint.method in (POSITION, POSITION_PID) or joint.target_mode == "position":
             return joint.frozen if joint.frozen is not None else joint.command
         return 0.0
 

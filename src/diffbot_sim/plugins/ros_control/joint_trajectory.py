@@ -43,6 +43,9 @@ class JointTrajectoryController(Controller):
         #: the velocity/effort variants close a PID loop in software: they run every physics step, as at
         #: Gazebo's default controlPeriod; the position variant hands targets to the joints' motors.
         self.closed_loop = self.cfg.variant != "position"
+        # the effort variant's PID is an explicit force; the velocity variant's drives velocity motors
+        self.by_position = (self.substitute_unstable(self.cfg.joints, self.cfg.gains, "position")
+                            if self.cfg.variant == "effort" and self.cfg.gains else set())
         self.goals = {}  # goal id -> actionlib ServerGoalHandle
         self.state_pub = self.own(ctx.publisher(join(name, "state"), msg.JointTrajectoryControllerState))
         self.command_sub = self.own(ctx.subscriber(join(name, "command"), JointTrajectory, self._on_command,
@@ -148,7 +151,7 @@ class JointTrajectoryController(Controller):
             raise ConfigError(f"{self.name}/gains", self.params.get("gains"),
                               f"gains for every joint ({err}: upstream's controller_manager crashes here)") from None
         super().start(now)
-        self._write(commands)
+        self._write(commands, self.hw.positions(self.cfg.joints))
         self.next_feedback = now
 
     def stop(self, now):
@@ -161,7 +164,7 @@ class JointTrajectoryController(Controller):
         result = self.core.update(now, period, self.hw.positions(joints), self.hw.velocities(joints))
         self._flush_log()
         if result.commands is not None:
-            self._write(result.commands)
+            self._write(result.commands, result.desired.positions)
         for event in result.events:
             self._finish(event)
         if result.state_due and self.state_pub.get_num_connections():
@@ -183,8 +186,11 @@ class JointTrajectoryController(Controller):
         else:
             handle.set_canceled()
 
-    def _write(self, commands):
-        for joint, value in zip(self.cfg.joints, commands):
+    def _write(self, commands, desired_positions):
+        """The adapter's commands, or for a joint run by position targets (``by_position``) its desired
+        position."""
+        for joint, value, desired in zip(self.cfg.joints, commands, desired_positions):
+            value = desired if joint in self.by_position else value
             if math.isfinite(value):
                 self.hw.set_command(joint, value)
 

@@ -68,8 +68,11 @@ class ControllerManager:
         """LoadController: build ``name`` from ``<ns>/<name>`` on the parameter server, stopped."""
         params = get_param(self.full_name(name), None)
         switching.check_load(name, self.loaded, params, KNOWN_TYPES)
+        told = len(self.ctx.warnings)
         controller = FACTORIES[params["type"]](self.ctx, self.hw, self.full_name(name), params,
                                                self.ns.rstrip("/") or "/")
+        for text in self.ctx.warnings[told:]:  # the start-up report is long gone: say it now
+            rospy.logwarn(f"controller_manager {self.ns}: {text}")
         self.loaded[name] = controller
         return controller
 
