@@ -57,6 +57,7 @@ class ArmTrajectory(unittest.TestCase):
         took = rospy.get_time() - t0
         self.assertEqual((state, result.error_code), (GoalStatus.SUCCEEDED, Result.SUCCESSFUL), result.error_string)
         self.assertLess(took, 2.0 + 1.0 + 0.5, "the goal ended long after its last point and goal_time")
+        wait_for(self.arm.at_rest, 20, "the arm at rest")
         self.assertTrue(close(self.arm.states.fresh() and self.arm.states.get(JOINTS), REACH, 0.03),
                         f"joints at {self.arm.states.get(JOINTS)}, goal {REACH}")
         self.arm.assert_body_agrees(self)
