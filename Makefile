@@ -3,7 +3,7 @@ SHELL := /bin/bash
 ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
 ENV := $(ROOT)/tools/rosenv.sh
 
-.PHONY: setup run test test-slow test-nav unit bench pictures clean nav
+.PHONY: setup run test test-slow test-nav unit bench pictures clean nav install
 
 setup:
 	@bash $(ROOT)/tools/setup.sh
@@ -36,9 +36,14 @@ nav: setup
 test-nav: setup
 	@bash $(ENV) python3 $(ROOT)/tools/run_tests.py --nav
 
+# An install space for users and images: DIR/setup.bash is all it needs, with this checkout gone (docs/install.md).
+PREFIX = $(ROOT)/install
+install: setup
+	@bash $(ROOT)/tools/install.sh "$(PREFIX)"
+
 unit: setup
 	@bash $(ENV) python3 -m pytest -q $(ROOT)/tests/unit
 
 
 clean:
-	rm -rf $(ROOT)/catkin_ws/build $(ROOT)/catkin_ws/devel $(ROOT)/catkin_ws/src $(ROOT)/test-results $(ROOT)/bench-results
+	rm -rf $(ROOT)/catkin_ws/build $(ROOT)/catkin_ws/build_install $(ROOT)/catkin_ws/devel $(ROOT)/catkin_ws/src $(ROOT)/test-results $(ROOT)/bench-results

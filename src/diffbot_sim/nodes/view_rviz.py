@@ -27,8 +27,16 @@ from diffbot_sim import streams
 from diffbot_sim.errors import DiffbotSimError
 from diffbot_sim.view import rviz_config
 
-TEMPLATE = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(
-    os.path.realpath(__file__))))), "rviz", "diffbot.rviz")
+def default_template():
+    """The package's ``rviz/diffbot.rviz``, found as roslaunch finds package files (rospkg): in a source
+    checkout and in an install space alike, where this module lives far from the package's share folder."""
+    import rospkg
+
+    try:
+        return os.path.join(rospkg.RosPack().get_path("diffbot_sim"), "rviz", "diffbot.rviz")
+    except rospkg.ResourceNotFound:
+        return os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(
+            os.path.realpath(__file__))))), "rviz", "diffbot.rviz")
 
 
 def parse_argv(argv):
@@ -36,7 +44,7 @@ def parse_argv(argv):
     passthrough = [a for a in argv if ":=" in a]
     parser = argparse.ArgumentParser(prog="view_rviz", description="rviz for the running simulator")
     parser.add_argument("--view", choices=rviz_config.VIEWS, default="top")
-    parser.add_argument("--template", default=TEMPLATE)
+    parser.add_argument("--template", default=None, help="default: the package's rviz/diffbot.rviz")
     parser.add_argument("--config", default="")
     parser.add_argument("--sim", default="/bullet_sim")
     parser.add_argument("--timeout", type=float, default=60.0)
@@ -133,6 +141,7 @@ def _prepare(argv):
         for robot in robots:
             robot.spawn = (robot.spawn[0] - sx, robot.spawn[1] - sy)
     try:
+        options.template = options.template or default_template()
         template = rviz_config.load_template(options.template)
     except Exception as err:  # yaml.YAMLError or OSError: either way the file is unusable
         raise DiffbotSimError(f"view_rviz: --template {options.template}: {err}") from None

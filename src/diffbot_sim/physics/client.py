@@ -21,9 +21,19 @@ def quiet(fd):
         os.close(saved)
 
 
-with quiet(1), quiet(2):
-    import pybullet  # noqa: F401 (the package's one import of it; world.py and robot.py take it from here)
-    import pybullet_data  # noqa: F401
+try:
+    with quiet(1), quiet(2):
+        import pybullet  # noqa: F401 (the package's one import of it; world.py and robot.py take it from here)
+        import pybullet_data  # noqa: F401
+except ImportError as _missing:
+    # One line and status 1, not a traceback: the usual cause is a node started by a Python other than the
+    # venv's (the checkout's .venv, or an install space's PREFIX/.venv: docs/install.md).
+    import sys
+
+    raise SystemExit(f"diffbot_sim: the Python package {_missing.name or 'pybullet'} is missing from "
+                     f"{sys.executable}: install it with `{sys.executable} -m pip install pybullet` "
+                     "(requirements.txt pins the version), or run the node with the venv's Python "
+                     "(docs/install.md)") from None
 
 
 #: Probe program: load PyBullet's EGL plugin in a throw-away process. On a machine without an EGL library

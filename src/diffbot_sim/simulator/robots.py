@@ -85,13 +85,26 @@ def spawn_robot(sim, cfg, params, name, text, source, pose):
 
 
 def _spawned_tf_prefix(model):
-    """A spawned robot's frames get the ``tf_prefix`` parameter of its plugins' namespace (the spawn
-    request's, once injected) when one is set, as gazebo_ros plugins read it; else none."""
+    """A spawned robot's frames get the ``tf_prefix`` Noetic's gazebo_ros plugins find: ``searchParam
+    ("tf_prefix")`` upward from their namespace (the spawn request's, once injected), or none: since
+    gazebo_ros_pkgs #1143/#1173 an unset tf_prefix no longer falls back to the namespace. A private
+    ``~tf_prefix`` of robot_state_publisher is not found (it lives under that node's name), as in Gazebo."""
     for block in model.gazebo:
         for element in block.element.iter("robotNamespace"):
             namespace = tag_value(element)
             if namespace:
-                return str(get_param(rospy.names.ns_join(namespace, "tf_prefix"), "")).strip("/")
+                return search_tf_prefix(namespace)
+    return ""
+
+
+def search_tf_prefix(namespace):
+    """roscpp's ``NodeHandle(namespace).searchParam("tf_prefix")``, its value stripped of slashes ("" if none)."""
+    parts = [p for p in namespace.split("/") if p]
+    for depth in range(len(parts), -1, -1):
+        name = "/" + "/".join(parts[:depth] + ["tf_prefix"])
+        value = get_param(name, None)
+        if value is not None:
+            return str(value).strip("/")
     return ""
 
 
