@@ -30,6 +30,8 @@ LAYERS = {
     "check": 5, "ros": 5,
     # running scenario files as processes, here or on Ray (no rospy: a run's ROS processes are children)
     "batch": 5,
+    # Gymnasium environments: a robot in a world in-process, through physics/ and the pure models (no rospy)
+    "gym": 5,
     # one module per Gazebo plugin (rospy)
     "plugins": 6,
     # bullet_sim at run time (rospy)

@@ -406,3 +406,79 @@ class World:
             with contextlib.suppress(OSError):
                 os.remove(path)
         self._files = []
+
+    # -- actors: bodies moved by a script, not by forces -----------------------------------------------------
+    def add_kinematic_box(self, size, pose):
+        """A box of ``size`` (x, y, z) [m] centred at ``pose`` ((x, y, z), (qx, qy, qz, qw)) that forces never
+        move (mass 0) and :meth:`move_body` places: rays, cameras and robots meet it where it was put. Returns
+        its PyBullet id."""
+        c = self.client
+        shape = pybullet.createCollisionShape(pybullet.GEOM_BOX, halfExtents=[v / 2.0 for v in size],
+                                              physicsClientId=c)
+        visual = pybullet.createVisualShape(pybullet.GEOM_BOX, halfExtents=[v / 2.0 for v in size],
+                                            rgbaColor=(0.85, 0.6, 0.45, 1.0), physicsClientId=c)
+        return pybullet.createMultiBody(0.0, shape, visual, pose[0], pose[1], physicsClientId=c)
+
+    def move_body(self, uid, pose):
+        """Place body ``uid`` (its base frame) at ``pose``."""
+        pybullet.resetBasePositionAndOrientation(uid, pose[0], pose[1], physicsClientId=self.client)
+
+    # -- learning environments (diffbot_sim.gym): snapshots, free space, contacts --------------------------
+    def save_state(self):
+        """Snapshot every body's pose, velocity and joint positions and velocities, and the contact caches
+        (PyBullet's in-memory ``saveState``); returns its id for :meth:`restore_state`.
+
+        A snapshot does not hold motor targets and modes, ``changeDynamics`` values (a robot's landing
+        damping), gravity or the time step: after a restore the motors keep what was last set (bullet3 #4364),
+        so the caller sets them again. Bodies may not be added or removed between save and restore.
+        """
+        return pybullet.saveState(physicsClientId=self.client)
+
+    def restore_state(self, state):
+        """Put every body back as snapshot ``state`` (:meth:`save_state`) holds it."""
+        pybullet.restoreState(stateId=state, physicsClientId=self.client)
+
+    def discard_state(self, state):
+        """Free snapshot ``state``."""
+        pybullet.removeState(state, physicsClientId=self.client)
+
+    def bounds(self, uid):
+        """Axis-aligned box (lo (x, y, z), hi (x, y, z)) [m], world axes, around every link of body ``uid``
+        (PyBullet's collision bounds; an infinite plane reads about +-1e30)."""
+        c = self.client
+        boxes = [pybullet.getAABB(uid, link, physicsClientId=c)
+                 for link in range(-1, pybullet.getNumJoints(uid, physicsClientId=c))]
+        lo = tuple(min(box[0][i] for box in boxes) for i in range(3))
+        hi = tuple(max(box[1][i] for box in boxes) for i in range(3))
+        return lo, hi
+
+    def free_of_bodies(self, points, radius, bottom, top, ignore=()):
+        """For each (x, y) of ``points``: True when an upright cylinder of ``radius`` [m] from height
+        ``bottom`` to ``top`` [m] there touches no body other than those in ``ignore`` (PyBullet ids), judged
+        on collision shapes (the broadphase names the candidates, then their closest points)."""
+        c = self.client
+        height = top - bottom
+        shape = pybullet.createCollisionShape(pybullet.GEOM_CYLINDER, radius=radius, height=height,
+                                              physicsClientId=c)
+        ignore = set(ignore)
+        free = []
+        try:
+            for x, y in points:
+                z = bottom + height / 2.0
+                lo, hi = (x - radius, y - radius, bottom), (x + radius, y + radius, top)
+                candidates = {(uid, link) for uid, link in
+                              (pybullet.getOverlappingObjects(lo, hi, physicsClientId=c) or ())
+                              if uid not in ignore}
+                free.append(not any(pybullet.getClosestPoints(
+                    bodyA=-1, bodyB=uid, distance=0.0, linkIndexB=link, collisionShapeA=shape,
+                    collisionShapePositionA=(x, y, z), physicsClientId=c) for uid, link in candidates))
+        finally:
+            with quiet(1), quiet(2):  # PyBullet prints a "TODO: dealloc" warning for every removed shape
+                pybullet.removeCollisionShape(shape, physicsClientId=c)
+        return free
+
+    def touching(self, body, ignore=()):
+        """PyBullet ids of the bodies that body ``body`` touches or penetrates after the last step (a contact
+        point at distance <= 0), other than itself and those in ``ignore``: a frozenset."""
+        return frozenset(point[2] for point in pybullet.getContactPoints(bodyA=body, physicsClientId=self.client)
+                         if point[8] <= 0.0 and point[2] != body and point[2] not in ignore)

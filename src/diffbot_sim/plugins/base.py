@@ -12,6 +12,7 @@ from typing import Optional
 import rospy
 
 from diffbot_sim.config import prefix_frame
+from diffbot_sim.control.schedule import next_due  # noqa: F401 (the plugins' scheduling rule)
 
 
 def publisher(name, msg_class):
@@ -45,16 +46,6 @@ def summary_key(kind, name):
     parts = [re.sub(r"[^A-Za-z0-9_]+", "_", part) for part in str(name).split("/") if part]
     parts = [part if part[:1].isalpha() else "n" + part for part in parts if part.strip("_")] or ["unnamed"]
     return "/".join([kind] + parts)
-
-
-def next_due(due, period, now):
-    """Next time after ``due`` (a multiple of ``period``); skips missed slots instead of bursting."""
-    if period <= 0:
-        return now
-    due += period
-    if due < now:
-        due = now + period
-    return due
 
 
 def finite_twist(ctx, msg, owner):

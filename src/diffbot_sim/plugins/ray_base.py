@@ -56,17 +56,9 @@ class RaySensorPlugin(Plugin):
         ctx.warnings.extend(cfg.warnings)
         self.name = sensor.name or sensor.path
         self.link = sensor.link
-        model = ctx.model
-        if not self.link or self.link not in model.links:
-            raise ConfigError(f"<gazebo reference> of {sensor.path}", self.link,
-                              "the name of a link of the model (a sensor is mounted on a link)")
-        self.pose = cfg.pose
-        parent_joint = next((j for j in model.joints.values() if j.child == self.link), None)
-        if parent_joint is not None and parent_joint.type == "fixed":
-            if cfg.has_pose and any(v != 0.0 for v in cfg.pose[0] + cfg.pose[1]):
-                ctx.warnings.append(f"{sensor.path}: <pose> dropped: link '{self.link}' is lumped into its parent "
-                                    "by a fixed joint, and Gazebo then puts the sensor at the link's frame")
-            self.pose = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+        self.pose, warning = ray_sensor.mounted_pose(cfg, ctx.model, self.link)
+        if warning is not None:
+            ctx.warnings.append(warning)
         self.directions = ray_sensor.ray_directions(cfg)
         rng = ray_sensor.noise_rng(sensor_seed(ctx, sensor.path), f"{ctx.spec.name or ''}/{self.name}")
         self.rng = rng

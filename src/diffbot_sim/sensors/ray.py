@@ -200,6 +200,28 @@ def parse_sensor(element, path, name=None):
     return cfg
 
 
+def mounted_pose(cfg, model, link):
+    """Where ray sensor ``cfg`` sits in the frame of ``link`` (a link of RobotModel ``model``), as Gazebo
+    places it: its ``<pose>``, or the link's own frame when the link is lumped into its parent by a fixed
+    joint (sdformat's URDF reader then replaces the sensor's pose). Returns (pose (xyz, rpy), a warning or
+    None): the warning says a non-zero ``<pose>`` was dropped.
+
+    Raises:
+        ConfigError: ``link`` is not a link of the model (a sensor is mounted on a link).
+    """
+    if not link or link not in model.links:
+        raise ConfigError(f"<gazebo reference> of {cfg.path}", link,
+                          "the name of a link of the model (a sensor is mounted on a link)")
+    parent_joint = next((j for j in model.joints.values() if j.child == link), None)
+    if parent_joint is None or parent_joint.type != "fixed":
+        return cfg.pose, None
+    warning = None
+    if cfg.has_pose and any(v != 0.0 for v in cfg.pose[0] + cfg.pose[1]):
+        warning = (f"{cfg.path}: <pose> dropped: link '{link}' is lumped into its parent by a fixed joint, and "
+                   "Gazebo then puts the sensor at the link's frame")
+    return ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)), warning
+
+
 # -- geometry -----------------------------------------------------------------------------------------------
 def ray_directions(cfg):
     """Unit vectors of the cast rays in the sensor frame, (rays, 3): vertical rows of horizontal sweeps.

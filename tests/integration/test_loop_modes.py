@@ -1,0 +1,136 @@
+#!/usr/bin/env python3
+"""loop_modes suite: a closed-loop controller gives the same trajectory at real time and in fast mode.
+
+The controller (a wall follower) runs on a rospy.Timer of 0.1 s of sim time: it takes the newest /scan, burns
+~15 ms of CPU as a real controller's computation would, and publishes cmd_vel. At real time that lag is 15 ms of
+sim time; in fast mode with ~wait_for_nodes the simulator holds sim time while the node works, so its commands
+act at the same sim times; unbounded, each command lands tens to hundreds of ms of sim time late and the path
+drifts. Judged by ground truth (~ground_truth): the fast run's poses at the same sim times stay within
+TOLERANCE of the real-time run's (with ~wait_for_nodes false the same check fails: measured 10+ cm)."""
+import math
+import os
+import sys
+import threading
+import time
+import unittest
+
+import numpy as np
+import rospy
+import rostest
+from gazebo_msgs.msg import ODEPhysics
+from gazebo_msgs.srv import SetPhysicsProperties
+from geometry_msgs.msg import Twist, Vector3
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import LaserScan
+from std_srvs.srv import Empty
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from simtest import wait_for  # noqa: E402
+
+RUN = 12.0  # s of sim time
+TOLERANCE = 0.05  # m: fast vs real time, at the same sim times
+TIME_STEP = 1.0 / 240.0
+
+
+class WallFollower:
+    """Keep 1 m from the wall on the right, turn away from walls ahead; 10 Hz in sim time."""
+
+    def __init__(self):
+        self.scan = None
+        self.cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
+        self.sub = rospy.Subscriber("/scan", LaserScan, self._keep, queue_size=1)
+        self.active = False
+        self.timer = rospy.Timer(rospy.Duration(0.1), self._tick, reset=True)  # survives reset_simulation
+
+    def _keep(self, msg):
+        self.scan = msg
+
+    def _range(self, angle):
+        scan = self.scan
+        k = int(round((angle - scan.angle_min) / scan.angle_increment)) % len(scan.ranges)
+        r = scan.ranges[k]
+        return r if math.isfinite(r) else scan.range_max
+
+    def _tick(self, _event):
+        if not self.active or self.scan is None:
+            return
+        end = time.monotonic() + 0.015
+        x = 1.0
+        while time.monotonic() < end:  # the controller's computation: CPU, not sleep
+            x = math.sin(x) + 1.0
+        twist = Twist()
+        front, right = self._range(0.0), self._range(-math.pi / 2)
+        twist.linear.x = 0.25
+        twist.angular.z = 1.5 if front < 0.9 else max(-0.6, min(0.6, 0.8 * (right - 1.0)))
+        self.cmd.publish(twist)
+
+
+class Truth:
+    def __init__(self):
+        self.lock = threading.Lock()
+        self.samples = []
+        self.sub = rospy.Subscriber("/bullet_sim/ground_truth", Odometry, self._keep, queue_size=100)
+
+    def _keep(self, msg):
+        p = msg.pose.pose.position
+        with self.lock:
+            self.samples.append((msg.header.stamp.to_sec(), p.x, p.y))
+
+    def take(self):
+        with self.lock:
+            out, self.samples = self.samples, []
+        return np.array(out)
+
+
+class LoopModes(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_loop_modes")
+        for name in ("reset_simulation", "set_physics_properties"):
+            rospy.wait_for_service(f"/gazebo/{name}", 30)
+        cls.reset = rospy.ServiceProxy("/gazebo/reset_simulation", Empty)
+        cls.physics = rospy.ServiceProxy("/gazebo/set_physics_properties", SetPhysicsProperties)
+        cls.follower = WallFollower()
+        cls.truth = Truth()
+        wait_for(lambda: cls.follower.scan is not None, 30, "a first scan")
+
+    def run_once(self, max_update_rate):
+        """Reset, set the pace (max_update_rate: 0 fast, 1/step real time), follow the wall for RUN s; the
+        ground-truth path [(t, x, y)] and the wall time it took."""
+        self.follower.active = False
+        self.physics(time_step=TIME_STEP, max_update_rate=max_update_rate, gravity=Vector3(0, 0, -9.8),
+                     ode_config=ODEPhysics())
+        self.reset()
+        wait_for(lambda: rospy.get_time() < 1.0, 10, "sim time back to 0")
+        self.truth.take()
+        started = time.monotonic()
+        self.follower.active = True
+        wait_for(lambda: rospy.get_time() >= RUN, 120, f"{RUN} s of sim time")
+        self.follower.active = False
+        self.follower.cmd.publish(Twist())
+        return self.truth.take(), time.monotonic() - started
+
+    @staticmethod
+    def deviation(a, b):
+        """Largest distance between two paths at the same sim times (b interpolated at a's stamps)."""
+        t = a[:, 0]
+        t = t[(t >= b[0, 0]) & (t <= b[-1, 0])]
+        xa, ya = np.interp(t, a[:, 0], a[:, 1]), np.interp(t, a[:, 0], a[:, 2])
+        xb, yb = np.interp(t, b[:, 0], b[:, 1]), np.interp(t, b[:, 0], b[:, 2])
+        return float(np.max(np.hypot(xa - xb, ya - yb)))
+
+    def test_fast_mode_follows_the_real_time_path(self):
+        reference, wall_rt = self.run_once(1.0 / TIME_STEP)
+        fast, wall_fast = self.run_once(0.0)
+        travelled = float(np.sum(np.hypot(np.diff(reference[:, 1]), np.diff(reference[:, 2]))))
+        d_fast = self.deviation(reference, fast)
+        print(f"FIGURE loop_modes: wall follower {RUN:g} s sim ({travelled:.2f} m): real time {wall_rt:.1f} s wall; "
+              f"fast {wall_fast:.1f} s wall ({RUN / wall_fast:.1f}x), path within {d_fast * 100:.1f} cm of the "
+              "real-time one", flush=True)
+        self.assertGreater(travelled, 2.0, "the follower did not drive")
+        self.assertLess(d_fast, TOLERANCE, f"fast mode's path left the real-time path by {d_fast:.3f} m")
+        self.assertLess(wall_fast, wall_rt, "fast mode was not faster than real time")
+
+
+if __name__ == "__main__":
+    rostest.rosrun("diffbot_sim", "loop_modes", LoopModes, sys.argv)
