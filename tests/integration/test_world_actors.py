@@ -1,0 +1,109 @@
+#!/usr/bin/env python3
+"""world_actors suite: an <actor> walks its script (its pose in model_states where the script puts it at that
+sim time) and the laser sees it there (Gazebo's CPU lasers do not); a model moved by /gazebo/set_model_state at
+30 Hz, as learning stages move obstacles, is seen at the pose set."""
+import math
+import os
+import sys
+import threading
+import unittest
+
+import rospy
+import rostest
+from gazebo_msgs.msg import ModelState, ModelStates
+from gazebo_msgs.srv import GetModelState
+from geometry_msgs.msg import Pose
+from sensor_msgs.msg import LaserScan
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from simtest import wait_for  # noqa: E402
+
+LASER_X, LASER_Z = 0.0, 0.113  # laser_robot.urdf: the laser's frame over the robot's origin
+NEAR_FACE = 1.75  # m: the walker's near face (x = 2.0 - half its 0.5 m width)
+
+
+class Scans:
+    def __init__(self):
+        self.lock = threading.Lock()
+        self.scans = []
+        self.sub = rospy.Subscriber("/scan", LaserScan, self._keep, queue_size=20)
+
+    def _keep(self, msg):
+        with self.lock:
+            self.scans.append(msg)
+
+    def after(self, t):
+        with self.lock:
+            return [s for s in self.scans if s.header.stamp.to_sec() >= t]
+
+
+def range_at(scan, bearing):
+    k = int(round((bearing - scan.angle_min) / scan.angle_increment)) % len(scan.ranges)
+    return scan.ranges[k]
+
+
+class WorldActors(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_world_actors")
+        rospy.wait_for_service("/gazebo/get_model_state", 30)
+        cls.get_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
+        cls.scans = Scans()
+        cls.states = []
+        cls.lock = threading.Lock()
+        rospy.Subscriber("/gazebo/model_states", ModelStates, cls._keep_states, queue_size=50)
+
+    @classmethod
+    def _keep_states(cls, msg):
+        with cls.lock:
+            cls.states.append((rospy.get_time(), msg))
+
+    def test_1_the_walker_is_a_model_and_the_laser_sees_it(self):
+        state = self.get_state("walker", "")
+        self.assertTrue(state.success, state.status_message)
+        seen = 0
+        start = rospy.get_time()
+        wait_for(lambda: rospy.get_time() > start + 6.0, 60, "6 s of sim time")
+        for scan in self.scans.after(start):
+            t = scan.header.stamp.to_sec()
+            with self.lock:
+                near = [m for (s, m) in self.states if abs(s - t) < 0.02 and "walker" in m.name]
+            if not near:
+                continue
+            pose = near[-1].pose[near[-1].name.index("walker")].position
+            if abs(pose.y) > 1.0:
+                continue
+            bearing = math.atan2(pose.y, NEAR_FACE - LASER_X)
+            want = (NEAR_FACE - LASER_X) / math.cos(bearing)
+            got = range_at(scan, bearing)
+            self.assertAlmostEqual(got, want, delta=0.05, msg=f"at t={t:.2f} the walker (y={pose.y:.2f}) is seen at "
+                                   f"{got:.3f} m, its near face is at {want:.3f} m")
+            self.assertAlmostEqual(pose.x, 2.0, delta=0.01)
+            seen += 1
+        self.assertGreater(seen, 5, "too few scans with the walker in front of the laser")
+
+    def test_2_a_model_moved_by_set_model_state_is_seen_where_it_was_set(self):
+        pub = rospy.Publisher("/gazebo/set_model_state", ModelState, queue_size=10)
+        wait_for(lambda: pub.get_num_connections() > 0, 10, "set_model_state subscribed")
+        rate = rospy.Rate(30)
+        checked = 0
+        for k in range(90):  # 3 s of sim time, the cube circling 1.2 m ahead of the robot
+            angle = -0.6 + 1.2 * k / 90
+            msg = ModelState(model_name="mover", pose=Pose(), reference_frame="world")
+            msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = 1.2 * math.cos(angle), \
+                1.2 * math.sin(angle), 0.15
+            msg.pose.orientation.w = 1.0
+            pub.publish(msg)
+            rate.sleep()
+            if k % 15 == 14:  # a scan after the last set: the cube's near face ~1.05 m along its bearing
+                t = rospy.get_time()
+                scan = wait_for(lambda: self.scans.after(t), 10, "a scan after the set")[0]
+                got = range_at(scan, math.atan2(msg.pose.position.y, msg.pose.position.x))
+                self.assertAlmostEqual(got, 1.2 - 0.15, delta=0.06, msg=f"the cube set at angle {angle:.2f} is "
+                                       f"seen at {got:.3f} m")
+                checked += 1
+        self.assertGreaterEqual(checked, 5)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("diffbot_sim", "world_actors", WorldActors, sys.argv)
