@@ -6,6 +6,9 @@ checked: /clock strictly increasing; every TF edge published by one node only; t
 angles, increments and ranges consistent; no TF extrapolation complaint from amcl or move_base on /rosout.
 
 Private parameters: ~goals ([[x, y, yaw], ...] in the map frame, which is the world's), ~xy_tolerance (0.25),
+~avoid (names of moving models, e.g. a walking actor, the body must never touch: its clearance to each, a box of
+~avoid_size [depth, width] m about the model's pose, must stay above ~body_radius m all along; ground truth from
+/gazebo/model_states),
 ~yaw_tolerance (0.35), ~goal_timeout (sim s, 180), ~truth_topic (the simulator's ground truth,
 /bullet_sim/ground_truth; /gazebo/<model>/ground_truth for a model spawned under the gazebo_ros drop-in), ~scan_frame (base_scan). Figures: time to each goal, its error, sim/wall time, RTF.
 """
@@ -43,9 +46,39 @@ class Recorder:
         rospy.Subscriber("/scan", LaserScan, self._scan, queue_size=10)
         rospy.Subscriber("/rosout_agg", Log, self._log, queue_size=1000)
         self.amcl = None
+        self.static_models = set(rospy.get_param("~static_models", ["ground_plane", "walls", "pillar", "ring",
+                                                                    "pushable_box"]))
         rospy.Subscriber("/amcl_pose", PoseWithCovarianceStamped, self._amcl, queue_size=1)
         self.status_at = time.monotonic()
         rospy.Subscriber("/move_base/status", GoalStatusArray, self._status, queue_size=1)
+        self.avoid = rospy.get_param("~avoid", [])
+        self.clearance = {name: math.inf for name in self.avoid}
+        if self.avoid:
+            from gazebo_msgs.msg import ModelStates
+
+            rospy.Subscriber("/gazebo/model_states", ModelStates, self._models, queue_size=1)
+
+    def _models(self, msg):
+        """The body's clearance to each model of ~avoid (their boxes), kept at its smallest."""
+        names = list(msg.name)
+        robot = next((n for n in names if n not in self.avoid and msg.pose[names.index(n)].position.z < 0.5
+                      and n not in self.static_models), None)
+        if robot is None:
+            return
+        body = msg.pose[names.index(robot)].position
+        depth, width = rospy.get_param("~avoid_size", [0.35, 0.5])
+        radius = float(rospy.get_param("~body_radius", 0.1))
+        for name in self.avoid:
+            if name not in names:
+                continue
+            pose = msg.pose[names.index(name)]
+            yaw = 2.0 * math.atan2(pose.orientation.z, pose.orientation.w)
+            dx, dy = body.x - pose.position.x, body.y - pose.position.y
+            along = dx * math.cos(yaw) + dy * math.sin(yaw)
+            across = -dx * math.sin(yaw) + dy * math.cos(yaw)
+            gap = math.hypot(max(abs(along) - depth / 2, 0.0), max(abs(across) - width / 2, 0.0)) - radius
+            with self.lock:
+                self.clearance[name] = min(self.clearance[name], gap)
 
     def _amcl(self, msg):
         with self.lock:
@@ -139,6 +172,10 @@ class NavigationTest(unittest.TestCase):
         sim_time, wall = rospy.get_time() - sim0, time.monotonic() - wall0
         figure(f"navigation: {len(goals)} goals in {sim_time:.1f} s of sim time, {wall:.1f} s of wall time: "
                f"RTF {sim_time / wall:.2f}")
+        for name, gap in self.rec.clearance.items():
+            figure(f"clearance to {name}: {gap * 100:.1f} cm at its smallest")
+            self.assertTrue(math.isfinite(gap), f"{name} was never seen in /gazebo/model_states")
+            self.assertGreater(gap, 0.0, f"the body touched {name} (clearance {gap:.3f} m)")
         self.check_consumers()
 
     def check_consumers(self):

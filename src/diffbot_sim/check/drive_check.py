@@ -1,13 +1,13 @@
-"""Judging a drive test by the body: at rest first, then straight at 0.2 m/s for 4 s and in place at
-0.5 rad/s for 4 s (pure).
+"""Judging a drive test by the body: at rest first, then straight at 0.2 m/s for 4 s, sideways at 0.2 m/s for 4 s
+(holonomic bases only) and in place at 0.5 rad/s for 4 s (pure).
 
 The fixture-robot rostests (tests/integration/test_real_robot.py) and ``robot_check`` drive a robot the same
 way and must agree on what "it drives" means, so the measuring and the tolerances live here once. The body is
 judged on the physics ground truth: before driving it rests upright at the height its geometry rests at on
 flat ground (:func:`rest`), while driving it stays there (:func:`ride`), and it moves and turns as commanded
-(:func:`straight`, :func:`turn`). The robot's own odometry is a second, separate claim, checked against the
-command too: a ros_control robot's odometry integrates its wheel encoders and reads a perfect drive while the
-body flies, sinks or slides. Motion poses are plain ``(x, y, yaw)`` tuples (m, m, rad) at the start and at the
+(:func:`straight`, :func:`strafe`, :func:`turn`; the motions: :func:`runs`). The robot's own odometry is a
+second, separate claim, checked against the command too: a ros_control robot's odometry integrates its wheel
+encoders and reads a perfect drive while the body flies, sinks or slides. Motion poses are plain ``(x, y, yaw)`` tuples (m, m, rad) at the start and at the
 end of a motion; body samples are :class:`BodySample` tuples; nothing here knows ROS messages.
 """
 import math
@@ -31,6 +31,43 @@ REST_SPEED = 0.02  # m/s: the fastest the body's origin may move over a rest
 TRUTH_TURN_FRACTION = 0.5  # of TURN * SECONDS: the least the body itself must turn in place
 SKID_TURN_FRACTION = 0.25  # the same for a skid-steered body (more than one wheel a side: its wheels slide)
 MAX_TURN_DRIFT = 0.1  # m the body's origin may move while turning in place
+#: fraction of the command: how closely a base whose plugin imposes its velocity (planar_move, the force-based
+#: move family) follows it, straight, sideways and turning, by ground truth (issue 30's fixtures)
+HOLONOMIC_TOLERANCE = 0.05
+#: Plugins (bullet_sim's ``~plugins`` names them) that move a body sideways too, so its drive test strafes.
+HOLONOMIC_PLUGINS = ("libgazebo_ros_planar_move.so", "libgazebo_ros_force_based_move.so",
+                     "libridgeback_ros_force_based_move.so", "libnexus_ros_force_based_move.so")
+
+
+class Run(NamedTuple):
+    """One judged motion: a Twist (linear.x, linear.y [m/s], angular.z [rad/s]) repeated at COMMAND_RATE for
+    ``seconds`` of sim time."""
+
+    name: str
+    linear_x: float
+    linear_y: float
+    angular_z: float
+    seconds: float
+
+
+STRAIGHT_RUN = Run("straight", SPEED, 0.0, 0.0, SECONDS)
+STRAFE_RUN = Run("sideways", 0.0, SPEED, 0.0, SECONDS)  # to the robot's left (REP 103: +y)
+TURN_RUN = Run("turn", 0.0, 0.0, TURN, SECONDS)
+#: The motions of a drive test, in order: a holonomic base strafes between the straight run and the turn.
+RUNS = (STRAIGHT_RUN, TURN_RUN)
+HOLONOMIC_RUNS = (STRAIGHT_RUN, STRAFE_RUN, TURN_RUN)
+
+
+def holonomic(plugins):
+    """True when one of ``plugins`` (filenames: a list, or bullet_sim's comma-separated ``~plugins``) moves
+    the body sideways (HOLONOMIC_PLUGINS)."""
+    names = plugins.split(",") if isinstance(plugins, str) else plugins
+    return any(name.strip() in HOLONOMIC_PLUGINS for name in names)
+
+
+def runs(is_holonomic):
+    """The motions to drive: HOLONOMIC_RUNS for a holonomic base, else RUNS."""
+    return HOLONOMIC_RUNS if is_holonomic else RUNS
 
 
 class BodySample(NamedTuple):
@@ -92,16 +129,64 @@ class Turn:
         return not self.failures
 
 
-def straight(odom_start, odom_end, truth_start, truth_end, expected=SPEED * SECONDS):
-    """Judge the straight run: on odometry and ground truth alike, the distance within DISTANCE_TOLERANCE of
-    ``expected`` and the heading changed by less than MAX_HEADING_CHANGE."""
+def straight(odom_start, odom_end, truth_start, truth_end, expected=SPEED * SECONDS, tolerance=DISTANCE_TOLERANCE):
+    """Judge the straight run: on odometry and ground truth alike, the distance within ``tolerance`` (a
+    fraction) of ``expected`` and the heading changed by less than MAX_HEADING_CHANGE."""
     result = Straight(expected, _distance(odom_start, odom_end), _distance(truth_start, truth_end),
                       abs(wrap(odom_end[2] - odom_start[2])), abs(wrap(truth_end[2] - truth_start[2])))
-    low, high = (1.0 - DISTANCE_TOLERANCE) * expected, (1.0 + DISTANCE_TOLERANCE) * expected
+    low, high = (1.0 - tolerance) * expected, (1.0 + tolerance) * expected
     for name, distance, heading in (("odometry", result.odom_distance, result.odom_heading),
                                     ("ground truth", result.truth_distance, result.truth_heading)):
         if not low < distance < high:
             result.failures.append(f"{name}: drove {distance:.3f} m, expected {low:.2f}..{high:.2f} m")
+        if not heading < MAX_HEADING_CHANGE:
+            result.failures.append(f"{name}: heading changed {heading:.3f} rad (limit {MAX_HEADING_CHANGE} rad)")
+    return result
+
+
+@dataclass
+class Strafe:
+    """The sideways run, measured on odometry and ground truth in the axes of the robot's heading at its
+    start; ``failures`` empty when it passed."""
+
+    expected: float  # m to the left
+    odom_left: float  # m along the start heading's +y
+    truth_left: float
+    odom_forward: float  # m along the start heading's +x (drift)
+    truth_forward: float
+    odom_heading: float  # rad, absolute heading change
+    truth_heading: float
+    failures: List[str] = field(default_factory=list)
+
+    @property
+    def passed(self):
+        return not self.failures
+
+
+def sideways(start, end):
+    """(left, forward) [m]: how far ``end`` is from ``start`` (x, y, yaw poses) along the start heading's +y
+    and +x."""
+    dx, dy = end[0] - start[0], end[1] - start[1]
+    c, s = math.cos(start[2]), math.sin(start[2])
+    return -s * dx + c * dy, c * dx + s * dy
+
+
+def strafe(odom_start, odom_end, truth_start, truth_end, expected=SPEED * SECONDS, tolerance=DISTANCE_TOLERANCE):
+    """Judge the sideways run (STRAFE_RUN): on odometry and ground truth alike, the distance to the robot's left
+    within ``tolerance`` (a fraction) of ``expected``, the drift along its heading under ``tolerance`` times
+    ``expected``, and the heading changed by less than MAX_HEADING_CHANGE."""
+    odom_left, odom_forward = sideways(odom_start, odom_end)
+    truth_left, truth_forward = sideways(truth_start, truth_end)
+    result = Strafe(expected, odom_left, truth_left, odom_forward, truth_forward,
+                    abs(wrap(odom_end[2] - odom_start[2])), abs(wrap(truth_end[2] - truth_start[2])))
+    low, high, drift = (1.0 - tolerance) * expected, (1.0 + tolerance) * expected, tolerance * expected
+    for name, left, forward, heading in (("odometry", odom_left, odom_forward, result.odom_heading),
+                                         ("ground truth", truth_left, truth_forward, result.truth_heading)):
+        if not low < left < high:
+            result.failures.append(f"{name}: moved {left:.3f} m to the left, expected {low:.2f}..{high:.2f} m")
+        if not abs(forward) < drift:
+            result.failures.append(f"{name}: drifted {forward:.3f} m along its heading while moving sideways "
+                                   f"(limit {drift:.2f} m)")
         if not heading < MAX_HEADING_CHANGE:
             result.failures.append(f"{name}: heading changed {heading:.3f} rad (limit {MAX_HEADING_CHANGE} rad)")
     return result
@@ -126,12 +211,12 @@ def centre_of(pose, centre):
 
 
 def turn(odom_start, odom_end, truth_start, truth_end, expected=TURN * SECONDS, truth_fraction=TRUTH_TURN_FRACTION,
-         max_moved=MAX_TURN_DRIFT, odom_fraction=1.0 - TURN_TOLERANCE, centre=(0.0, 0.0)):
+         max_moved=MAX_TURN_DRIFT, odom_fraction=1.0 - TURN_TOLERANCE, centre=(0.0, 0.0), tolerance=TURN_TOLERANCE):
     """Judge the turn in place: the ground truth turns the commanded way by at least ``truth_fraction`` of
-    ``expected`` and at most TURN_TOLERANCE over it, and the point it turns about, ``centre`` (x, y) [m] in
-    the root link's frame (the middle of the drive wheels: a base_link ahead of or behind the axle circles
-    it), moves less than ``max_moved`` [m]; the odometry's yaw change is within ``odom_fraction``..1 +
-    TURN_TOLERANCE of ``expected``.
+    ``expected`` and at most ``tolerance`` (a fraction) over it, and the point it turns about, ``centre``
+    (x, y) [m] in the root link's frame (the middle of the drive wheels: a base_link ahead of or behind the
+    axle circles it), moves less than ``max_moved`` [m]; the odometry's yaw change is within
+    ``odom_fraction``..1 + ``tolerance`` of ``expected``.
 
     A four-wheel robot driven as a diff drive turns its body slower than its wheels say (its wheels slide
     sideways), which its own odometry does not see, so callers may lower ``truth_fraction`` for it (skid
@@ -140,7 +225,7 @@ def turn(odom_start, odom_end, truth_start, truth_end, expected=TURN * SECONDS, 
     """
     result = Turn(expected, wrap(odom_end[2] - odom_start[2]), wrap(truth_end[2] - truth_start[2]),
                   _distance(centre_of(truth_start, centre), centre_of(truth_end, centre)))
-    high = (1.0 + TURN_TOLERANCE) * expected
+    high = (1.0 + tolerance) * expected
     low = odom_fraction * expected
     if not low < result.odom_yaw < high:
         result.failures.append(f"odometry: turned {result.odom_yaw:.3f} rad, expected {low:.2f}..{high:.2f} rad")

@@ -248,16 +248,6 @@ class Robot:
         local_w, local_a = into_frame(pose[1], angular, accel)
         return pose, local_w, local_a, linear
 
-    def set_planar_velocity(self, vx, vy, wz):
-        """Holonomic body velocity (gazebo_ros_planar_move): ``vx, vy`` [m/s] in the base frame's heading,
-        ``wz`` [rad/s] about the world z. The vertical velocity is left to gravity and contacts."""
-        linear, _ = pybullet.getBaseVelocity(self.body, physicsClientId=self.client)
-        _, orientation = self.base_pose()
-        yaw = pybullet.getEulerFromQuaternion(orientation)[2]
-        c, s = math.cos(yaw), math.sin(yaw)
-        pybullet.resetBaseVelocity(self.body, (c * vx - s * vy, s * vx + c * vy, linear[2]), (0.0, 0.0, wz),
-                                   physicsClientId=self.client)
-
     def link_carrier(self, name):
         """PyBullet link index carrying URDF link ``name`` (lumped links: their carrier). KeyError if none."""
         carrier = self.frames[name][0] if self.frames else name
@@ -349,3 +339,65 @@ class Robot:
         if link == -1:
             return tuple(pybullet.getBasePositionAndOrientation(body, physicsClientId=self.client)[0])
         return tuple(pybullet.getLinkState(body, link, physicsClientId=self.client)[4])
+
+    # -- holonomic base plugins (gazebo_ros_planar_move, the force-based move family) ------------------------
+    def heading_velocity(self):
+        """(vx, vy, wz): the velocity [m/s] of the root's centre of mass along the axes of the root link's
+        heading (its yaw alone) and the yaw rate [rad/s] about the world z; what :meth:`set_heading_velocity`
+        sets, read back after a step to see what contacts and joint motors took of it."""
+        linear, angular = pybullet.getBaseVelocity(self.body, physicsClientId=self.client)
+        _, orientation = self.base_pose()
+        yaw = pybullet.getEulerFromQuaternion(orientation)[2]
+        c, s = math.cos(yaw), math.sin(yaw)
+        return c * linear[0] + s * linear[1], -s * linear[0] + c * linear[1], angular[2]
+
+    def set_heading_velocity(self, vx, vy, wz):
+        """Gazebo's Model::SetLinearVel((vx, vy) [m/s] turned by the root link's yaw, z 0) and
+        SetAngularVel((0, 0, wz) [rad/s]) as gazebo_ros_planar_move calls them: the root's centre of mass gets
+        that velocity, its roll and pitch rates and its vertical velocity are zeroed. Joint rates are kept, so
+        every other link moves rigidly with the root (Gazebo gives each link the same velocity and lets ODE's
+        joints reconcile them)."""
+        _, orientation = self.base_pose()
+        yaw = pybullet.getEulerFromQuaternion(orientation)[2]
+        c, s = math.cos(yaw), math.sin(yaw)
+        pybullet.resetBaseVelocity(self.body, (c * vx - s * vy, s * vx + c * vy, 0.0), (0.0, 0.0, wz),
+                                   physicsClientId=self.client)
+
+    def planar_inertia(self):
+        """(mass [kg], moment of inertia [kg·m^2] about the vertical axis through the centre of mass) of the
+        whole robot in its present configuration: what a horizontal force and a yaw torque on its body move
+        (stability checks of the force-based move plugin's P loops)."""
+        c = self.client
+        parts = []  # (mass, centre of mass (world), izz about a vertical axis through it)
+        for index in range(-1, pybullet.getNumJoints(self.body, physicsClientId=c)):
+            info = pybullet.getDynamicsInfo(self.body, index, physicsClientId=c)
+            if index == -1:
+                com, orientation = pybullet.getBasePositionAndOrientation(self.body, physicsClientId=c)
+            else:
+                state = pybullet.getLinkState(self.body, index, computeForwardKinematics=1, physicsClientId=c)
+                com, orientation = state[0], state[1]
+            row = pybullet.getMatrixFromQuaternion(orientation)[6:9]  # world z in the inertia's principal axes
+            parts.append((info[0], com, sum(row[k] ** 2 * info[2][k] for k in range(3))))
+        mass = sum(m for m, _, _ in parts)
+        if mass <= 0:
+            return 0.0, 0.0
+        cx = sum(m * p[0] for m, p, _ in parts) / mass
+        cy = sum(m * p[1] for m, p, _ in parts) / mass
+        return mass, sum(izz + m * ((p[0] - cx) ** 2 + (p[1] - cy) ** 2) for m, p, izz in parts)
+
+    def push_link(self, name, force, torque):
+        """For the coming step (PyBullet clears it after), ``force`` [N] along the axes of URDF link ``name``'s
+        frame, at the centre of mass of the link carrying it, and ``torque`` [N·m] in world axes: Gazebo's
+        Link::AddRelativeForce and Link::AddTorque. KeyError if the model has no such link."""
+        c = self.client
+        index = self.link_carrier(name)
+        _, orientation = self.link_pose(name)
+        world_force, _ = pybullet.multiplyTransforms((0, 0, 0), orientation, force, (0, 0, 0, 1))
+        if index == -1:
+            com = pybullet.getBasePositionAndOrientation(self.body, physicsClientId=c)[0]
+        else:
+            com = pybullet.getLinkState(self.body, index, physicsClientId=c)[0]
+        if any(world_force):
+            pybullet.applyExternalForce(self.body, index, world_force, com, pybullet.WORLD_FRAME, physicsClientId=c)
+        if any(torque):
+            pybullet.applyExternalTorque(self.body, index, torque, pybullet.WORLD_FRAME, physicsClientId=c)

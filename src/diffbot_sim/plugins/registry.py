@@ -7,6 +7,7 @@ from diffbot_sim.description.plugin_tags import DIFF_DRIVE, JOINT_STATE, plugin_
 from diffbot_sim.errors import PluginNotLoaded
 from diffbot_sim.plugins import (
     diff_drive,
+    force_based_move,
     gps,
     grasp_fix,
     imu,
@@ -30,6 +31,9 @@ from diffbot_sim.plugins.range import create as create_range
 MODEL_PLUGINS = {
     "libgazebo_ros_skid_steer_drive.so": skid_steer.create,
     "libgazebo_ros_planar_move.so": planar_move.create,
+    "libgazebo_ros_force_based_move.so": force_based_move.create,
+    "libridgeback_ros_force_based_move.so": force_based_move.create,
+    "libnexus_ros_force_based_move.so": force_based_move.create,
     "libgazebo_ros_kobuki.so": kobuki.create,
     "libgazebo_ros_control.so": ros_control.create,
     "libgazebo_ros_imu.so": imu.create_model,

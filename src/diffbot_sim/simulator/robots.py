@@ -193,7 +193,7 @@ def _report_robot(cfg, item):
     for block in (found.diff_drive, found.joint_state):
         if block is not None and block.unknown_tags:
             rospy.logwarn(f"{who}{block.path}: unknown tags ignored: {', '.join(block.unknown_tags)}")
-    if not any(p.joints() or p.filename == "libgazebo_ros_planar_move.so" for p in runtime.plugins):
+    if not any(p.joints() or getattr(p, "moves_base", False) for p in runtime.plugins):
         rospy.logwarn(who + "the model has no drive plugin or controller that bullet_sim simulates (and no "
                       "~left_joints): nothing moves it")
     params = {}

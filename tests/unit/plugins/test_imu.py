@@ -248,7 +248,7 @@ def test_lumped_imu_at_rest_reads_plus_g_and_no_rate(box):
 def test_imu_in_a_known_spin_reads_the_yaw_rate_and_centripetal_acceleration(box):
     world, robot = box
     sample(world, robot, "imu_link", 0.5)
-    readings = sample(world, robot, "imu_link", 1.0, each=lambda: robot.set_planar_velocity(0.0, 0.0, 0.5))
+    readings = sample(world, robot, "imu_link", 1.0, each=lambda: robot.set_heading_velocity(0.0, 0.0, 0.5))
     for _, w, a in readings[5:]:
         assert w == pytest.approx((0.0, 0.0, 0.5), abs=1e-3)  # the IMU frame is yawed 90 deg: z unchanged
         # 0.1 m off the spin axis: 0.5^2 * 0.1 = 0.025 m/s^2 towards the axis (-x of base = +y of the IMU)
@@ -260,7 +260,7 @@ def test_link_twist_of_a_moving_link(box):
     world, robot = box
     sample(world, robot, "imu_link", 0.2)
     for _ in range(24):
-        robot.set_planar_velocity(0.3, 0.0, 0.0)
+        robot.set_heading_velocity(0.3, 0.0, 0.0)
         world.step()
     _, v, w = robot.link_twist("imu_link")
     # the base moves +x at 0.3 m/s; the IMU frame is yawed 90 deg, so that is -y in it
