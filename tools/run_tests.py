@@ -176,6 +176,8 @@ def _skip_reason(name):
 NAV_FIXTURES = os.path.join(ROOT, "tests", "data", "nav_way")
 #: A Gazebo user's mobile-manipulator packages (their own launch files, YAML and URDF) the arm suites launch.
 MANIPULATOR_FIXTURES = os.path.join(ROOT, "tests", "data", "manipulator_way")
+#: A Gazebo user's multi-robot packages (a TurtleBot3-class robot, a house of meshes) the multi_way suites launch.
+MULTI_FIXTURES = os.path.join(ROOT, "tests", "data", "multi_way")
 NAV_NEEDS = ("move_base", "amcl", "map_server", "gmapping", "dwa_local_planner")
 
 
@@ -282,6 +284,7 @@ def main():
         return run_nav(args)
     os.makedirs(RESULTS, exist_ok=True)
     add_package_path(MANIPULATOR_FIXTURES)
+    add_package_path(MULTI_FIXTURES)
     total_p = total_f = total_s = 0
     failures = []
     if args.only is None:

@@ -161,4 +161,7 @@ def create(ctx, block, params):
     drive.robot_base_frame = ctx.clean_frame(drive.robot_base_frame, where)
     if ctx.namespace:
         cfgmod.place_in_namespace(ctx.spec, drive, None)
+    else:  # a spawned robot: the tf_prefix its namespace's searchParam found (Noetic's gazebo_ros_utils)
+        drive.odometry_frame = ctx.frame(drive.odometry_frame)
+        drive.robot_base_frame = ctx.frame(drive.robot_base_frame)
     return DiffDrive(ctx, drive)

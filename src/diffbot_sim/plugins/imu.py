@@ -356,7 +356,8 @@ class ImuPlugin(Plugin):
         ns = ctx.plugin_namespace(settings.namespace)
         self.pub = ctx.publisher(join(ns, settings.topic), Imu)
         self.bias_pub = ctx.publisher(join(ns, settings.bias_topic), Imu) if settings.bias_topic else None
-        self.frame_id = ctx.frame(ctx.clean_frame(settings.frame, path))
+        # Noetic's gazebo_ros_imu and imu_sensor read no tf_prefix: their frame is the tag's, as written
+        self.frame_id = ctx.clean_frame(settings.frame, path)
         self.service = None
         if settings.service:
             from std_srvs.srv import Empty, EmptyResponse

@@ -99,17 +99,17 @@ class NodeSync:
 
     # -- who is subscribed --------------------------------------------------------------------------------
     @staticmethod
-    def subscribers(pub):
+    def subscribers(pub, peek=True):
         """Caller ids with an open connection to ``pub``. A subscriber that unsubscribed has closed its end,
-        but rospy notices only at its next write: the socket is peeked (a subscriber never sends after the
-        handshake: no data means open, end of file means gone)."""
+        but rospy notices only at its next write: with ``peek`` the socket is peeked (a subscriber never sends
+        after the handshake: no data means open, end of file means gone)."""
         impl = pub.impl
         if impl is None:
             return set()
         names = set()
         for conn in list(impl.connections):
             sock = getattr(conn, "socket", None)
-            if sock is not None:
+            if peek and sock is not None:
                 try:
                     if sock.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) == b"":
                         continue
@@ -152,7 +152,7 @@ class NodeSync:
             seq = getattr(impl, "seq", 0) if impl is not None else 0
             if seq != self.seq.get(pub):
                 self.seq[pub] = seq
-                subs = self.subscribers(pub)
+                subs = self.subscribers(pub, peek=False)  # who was sent the message (a closed one is seen later)
                 if subs:
                     self.listeners[pub] = subs
                     fresh.append(pub)
