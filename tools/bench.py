@@ -21,6 +21,7 @@ Items (issue 11):
   sensors    a robot with a 360-beam laser at 5 Hz and an IMU at 100 Hz, both subscribed (with /odom and
              /tf), in worlds/room.world: fast-mode RTF (median of 3) and real-time simulator CPU (30 s).
              Cameras: tools/camera_speed.py.
+Items of tools/bench_wave.py: arm, lockstep, gym, fleet (see its docstring).
 Items (issue 10):
   worlds     roslaunch -> first /odom in a world of 30 models with COLLADA collision meshes (empty mesh
              cache), and with a 4000 x 4000 map image (a floor plan, and the same with 2 % speckle);
@@ -308,6 +309,14 @@ def probe_world_api(options):
 
 PROBES = {"count": probe_count, "rtf": probe_rtf, "latency": probe_latency, "first_odom": probe_first_odom,
           "world_api": probe_world_api}
+
+
+def _wave():
+    """tools/bench_wave.py (the manipulator, loop and fleet items), imported late: it imports this module."""
+    sys.path.insert(0, HERE)
+    import bench_wave
+
+    return bench_wave
 
 
 # -------------------------------------------------------------------------------------------------- items
@@ -793,6 +802,7 @@ def table(r):
                   f"{b['jobs1']['runs_per_hour_per_core']:.0f} / {b['jobs2']['runs_per_hour_per_core']:.0f}", ""),
                  ("  speed-up of --jobs 2 over --jobs 1 (2 cores)",
                   f"{b['jobs1']['wall_s'] / b['jobs2']['wall_s']:.2f}", "")]
+    rows += _wave().rows(r)
     width = max(len(name) for name, _, _ in rows)
     lines = [f"{'measure'.ljust(width)}  {'value':>28}  target", "-" * (width + 40)]
     lines += [f"{name.ljust(width)}  {value:>28}  {target}" for name, value, target in rows]
@@ -801,15 +811,16 @@ def table(r):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--probe", choices=sorted(PROBES), help=argparse.SUPPRESS)
+    parser.add_argument("--probe", help=argparse.SUPPRESS)
     parser.add_argument("--options", default="{}", help=argparse.SUPPRESS)
     parser.add_argument("--only", default="fast,realtime,latency,startup,scale,meshes,ros_control,worlds,sensors,"
-                        "world_api,batch",
+                        "world_api,batch,arm,lockstep,gym,fleet",
                         help="comma-separated items to run (default: all)")
     parser.add_argument("--quick", action="store_true", help="shorter windows (smoke run, not for figures)")
     args = parser.parse_args()
     if args.probe:
-        PROBES[args.probe](json.loads(args.options))
+        probes = dict(PROBES, **_wave().PROBES)
+        probes[args.probe](json.loads(args.options))
         return 0
     os.makedirs(RESULTS, exist_ok=True)
     items = set(args.only.split(","))
@@ -825,6 +836,7 @@ def main():
              ("sensors", lambda: bench_sensors(1 if q else 3, 4 if q else 10, 10 if q else 30)),
              ("world_api", lambda: bench_world_api(3 if q else 7, 100 if q else 1000)),
              ("batch", lambda: bench_batch(2 if q else 5))]
+    steps += [(name, lambda run=run: run(q)) for name, run in _wave().STEPS]
     for name, run in steps:
         wanted = name in items or (name == "scale_rsp" and "scale" in items)
         if not wanted:

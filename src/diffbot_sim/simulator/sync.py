@@ -24,6 +24,7 @@ While it waits, the loop keeps serving requests (services, spawns, resets).
 """
 import fnmatch
 import os
+import select
 import socket
 import time
 import xmlrpc.client
@@ -33,6 +34,9 @@ import rosgraph
 
 #: wall seconds between two looks at the waited-for nodes
 POLL = 0.0002
+#: wall seconds a subscriber that connected since the previous message is given to drop its connection (a
+#: rospy.wait_for_message client drops it within its 10 ms poll) before it counts as one that stays
+FRESH_GRACE = 0.05
 LOCAL_HOSTS = ("localhost", "127.0.0.1", "::1")
 
 
@@ -92,33 +96,29 @@ class NodeSync:
         self.own_name = own_name
         self.warn = warn
         self.nodes = {}  # caller id -> WatchedNode, or None (not watchable: other host, ignored, gone)
-        self.listeners = {}  # publisher -> set of caller ids subscribed when it last published
+        self.listeners = {}  # publisher -> {caller id: (its connection, fresh)} when it last published
+        self._connections = {}  # publisher -> the connections it had at its previous message
         self.seq = {}  # publisher -> its message count when last looked at
         self.waited = 0.0  # wall seconds spent waiting, for the achieved-RTF report
         self.holds = 0
 
     # -- who is subscribed --------------------------------------------------------------------------------
     @staticmethod
-    def subscribers(pub, peek=True):
-        """Caller ids with an open connection to ``pub``. A subscriber that unsubscribed has closed its end,
-        but rospy notices only at its next write: with ``peek`` the socket is peeked (a subscriber never sends
-        after the handshake: no data means open, end of file means gone)."""
+    def connections(pub, peek=True):
+        """{connection: caller id} of ``pub``'s subscribers. A subscriber that unsubscribed has closed its end,
+        but rospy notices only at its next write: with ``peek`` such connections are left out (a subscriber
+        never sends after the handshake: a readable socket at end of file is gone)."""
         impl = pub.impl
         if impl is None:
-            return set()
-        names = set()
+            return {}
+        out = {}
         for conn in list(impl.connections):
             sock = getattr(conn, "socket", None)
-            if peek and sock is not None:
-                try:
-                    if sock.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) == b"":
-                        continue
-                except (BlockingIOError, InterruptedError):
-                    pass
-                except OSError:
-                    continue
-            names.add(getattr(conn, "endpoint_id", None))
-        return names - {None}
+            name = getattr(conn, "endpoint_id", None)
+            if name is None or (peek and sock is not None and _closed_by_peer(sock)):
+                continue
+            out[conn] = name
+        return out
 
     def _node(self, name):
         if name not in self.nodes:
@@ -152,9 +152,12 @@ class NodeSync:
             seq = getattr(impl, "seq", 0) if impl is not None else 0
             if seq != self.seq.get(pub):
                 self.seq[pub] = seq
-                subs = self.subscribers(pub, peek=False)  # who was sent the message (a closed one is seen later)
-                if subs:
-                    self.listeners[pub] = subs
+                conns = self.connections(pub, peek=False)  # who was sent the message (a closed one is seen later)
+                before = self._connections.get(pub, {})
+                self._connections[pub] = conns
+                if conns:
+                    # fresh: connected since the previous message, as a one-shot (wait_for_message) subscriber is
+                    self.listeners[pub] = {name: (conn, conn not in before) for conn, name in conns.items()}
                     fresh.append(pub)
         return fresh
 
@@ -162,7 +165,7 @@ class NodeSync:
         """Every node subscribed to a sensor topic when it last published: the nodes in the loop."""
         names = set()
         for listeners in self.listeners.values():
-            names |= listeners
+            names |= set(listeners)
         return names
 
     def busy_nodes(self, now_wall):
@@ -175,24 +178,32 @@ class NodeSync:
                 out.append((name, "busy"))
         return out
 
-    def pending(self, publishers, now_wall):
-        """The nodes the simulator still waits for after ``publishers`` sent a message, as (name, why)
-        pairs; no publishers: after a /clock tick (busy nodes only)."""
+    def pending(self, publishers, now_wall, elapsed=0.0):
+        """The nodes the simulator still waits for, ``elapsed`` wall seconds after ``publishers`` sent a message,
+        as (name, why) pairs; no publishers: after a /clock tick (busy nodes only).
+
+        A listener has answered when it is idle and: still on the connection that got the message (a subscriber
+        that stays), unless that connection was fresh (made since the previous message, as a
+        ``wait_for_message`` client's is) and FRESH_GRACE has not passed, in which case the client is given
+        the time to drop it; or on a new connection (a client that dropped the old one and waits again)."""
         if not publishers:
             return self.busy_nodes(now_wall)
         out = []
         for pub in publishers:
-            now_subscribed = None
-            for name in self.listeners.get(pub, ()):
+            now = None
+            for name, (conn, fresh) in self.listeners.get(pub, {}).items():
                 node = self._node(name)
                 if node is None or node.dropped:
                     continue
                 if node.busy(now_wall):
                     out.append((name, "busy"))
                     continue
-                if now_subscribed is None:
-                    now_subscribed = self.subscribers(pub)
-                if name not in now_subscribed:
+                if now is None:
+                    now = self.connections(pub)
+                if conn in now:
+                    if fresh and elapsed < FRESH_GRACE:
+                        out.append((name, "a new subscriber: dropping it after one message?"))
+                elif name not in now.values():
                     out.append((name, f"not subscribed to {pub.resolved_name} again yet"))
         return out
 
@@ -205,7 +216,7 @@ class NodeSync:
         waiting_since = {}
         while True:
             now = time.monotonic()
-            pending = self.pending(publishers, now)
+            pending = self.pending(publishers, now, now - started)
             if not pending or stop():
                 break
             for name, why in pending:
@@ -221,12 +232,24 @@ class NodeSync:
         self.waited += time.monotonic() - started
 
     def forget_drops(self, publishers):
-        """A node that subscribes anew is waited for again."""
+        """A node that subscribes anew (a fresh connection got this message) is waited for again."""
         for pub in publishers:
-            for name in self.subscribers(pub) - self.listeners.get(pub, set()):
+            for name, (_, fresh) in self.listeners.get(pub, {}).items():
                 node = self.nodes.get(name)
-                if node is not None:
+                if fresh and node is not None:
                     node.dropped = False
+
+
+def _closed_by_peer(sock):
+    """Whether the other end closed ``sock``: readable now (a poll that does not wait: the socket's own timeout,
+    set for sending, would make a peeking recv block for it) and reading end of file."""
+    try:
+        readable, _, _ = select.select([sock], [], [], 0.0)
+        return bool(readable) and sock.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) == b""
+    except (BlockingIOError, InterruptedError):
+        return False
+    except (OSError, ValueError):
+        return True
 
 
 def _is_local(host):
