@@ -9,6 +9,9 @@
    ``docs/run.png`` (``plot_run``'s picture of the recording).
 3. ``view.launch gui:=true rviz:=false``: ``docs/pybullet.png`` is PyBullet's window once the simulator has
    built the world and the robot and the window's 3-D view has stopped changing.
+4. ``docs/manipulator.png`` (:func:`manipulator_picture`; also alone: ``tools/pictures.py manipulator``):
+   diffbot_arm in worlds/pick_place.world holding the box above the pick table, the pose and the box placed
+   as pick_place's lift step leaves them (no ROS, no display: PyBullet's TinyRenderer).
 
 Every process is started in its own session and stopped by its process group; each run has its own master
 (``roslaunch -p PORT``). Prints one line per step, so a reader knows it is alive (about 1 min in all).
@@ -179,7 +182,55 @@ class Recorder:
             return list(self.records)
 
 
+def manipulator_picture(path):
+    """docs/manipulator.png: diffbot_arm at the pick table (base_link 0.16 m before the box, as
+    control.pick_place plans it) with the box lifted 10 cm between its closed fingers."""
+    import pybullet
+
+    from diffbot_sim.check.arm_check import forward_kinematics
+    from diffbot_sim.control import pick_place
+    from diffbot_sim.description import meshes
+    from diffbot_sim.description.model_files import load_file
+    from diffbot_sim.description.urdf_model import parse_urdf
+    from diffbot_sim.physics import World
+    from diffbot_sim.world.loading import load_world
+
+    world = World(1.0 / 240.0)
+    try:
+        world.load_world(load_world(os.path.join(ROOT, "worlds", "pick_place.world"), 1.0), meshes.default_cache_dir())
+        text = load_file(os.path.join(ROOT, "urdf", "diffbot_arm.urdf.xacro"))
+        model = parse_urdf(text)
+        scene = pick_place.Scene()
+        arm = pick_place.arm_geometry({k: v[0] for k, v in forward_kinematics(model, {}).items()})
+        robot = world.load_robot(text, model, (scene.pick[0] - scene.standoff, 0.0, 0.0))
+        lift = pick_place.top_down(arm, scene.standoff, scene.pick[2] + scene.grasp_above + scene.carry_lift)
+        joints = dict(zip(pick_place.ARM_JOINTS, (0.0,) + lift),
+                      left_finger_joint=scene.object_size / 2, right_finger_joint=scene.object_size / 2)
+        robot.set_joint_positions(robot.indices(list(joints)), list(joints.values()))
+        tcp = robot.link_pose("gripper_tcp_link")[0]
+        box = next(uid for uid, body in world.world_bodies if body.top_model == "pick_box")
+        pybullet.resetBasePositionAndOrientation(box, (tcp[0], tcp[1], tcp[2] - scene.grasp_above), (0, 0, 0, 1),
+                                                 physicsClientId=world.client)
+        view = pybullet.computeViewMatrixFromYawPitchRoll((0.45, 0.0, 0.16), 0.9, 55.0, -28.0, 0.0, 2,
+                                                          physicsClientId=world.client)
+        projection = pybullet.computeProjectionMatrixFOV(45.0, 1.5, 0.05, 10.0, physicsClientId=world.client)
+        width, height = 1200, 800
+        _, _, rgba, _, _ = pybullet.getCameraImage(width, height, view, projection, shadow=1,
+                                                   lightDirection=(1.0, -1.0, 2.0),
+                                                   renderer=pybullet.ER_TINY_RENDERER, physicsClientId=world.client)
+    finally:
+        world.close()
+    import numpy as np
+
+    image = np.reshape(np.asarray(rgba, dtype=np.uint8), (height, width, 4))[:, :, :3]
+    xscreen.save_png(image, path, MAX_WIDTH)
+
+
 def main():
+    if sys.argv[1:] == ["manipulator"]:
+        manipulator_picture(os.path.join(DOCS, "manipulator.png"))
+        say("docs/manipulator.png")
+        return 0
     from diffbot_sim.nodes import plot_run
     from diffbot_sim.view import plot_data
 
@@ -218,10 +269,12 @@ def main():
             say("docs/pybullet.png")
         finally:
             gui.stop()
+    manipulator_picture(os.path.join(DOCS, "manipulator.png"))
+    say("docs/manipulator.png")
     median = statistics.median(times)
     say(f"roslaunch -> first rviz frame with the robot, under Xvfb: median {median:.2f} s of {RUNS} "
         f"({', '.join(f'{t:.2f}' for t in times)})")
-    for name in ("rviz.png", "run.png", "pybullet.png"):
+    for name in ("rviz.png", "run.png", "pybullet.png", "manipulator.png"):
         size = os.path.getsize(os.path.join(DOCS, name))
         say(f"docs/{name}: {size // 1024} KB" + (" (over 200 KB!)" if size > 200 * 1024 else ""))
     return 0

@@ -106,3 +106,44 @@ def test_a_bad_model_is_one_line_and_status_1(tmp_path, args, culprit):
     assert proc.stderr.count("\n") == 1 and proc.stderr.startswith("robot_check: ") and culprit in proc.stderr, \
         proc.stderr
     assert "Traceback" not in proc.stdout + proc.stderr
+
+
+def test_the_mobile_manipulator_drives_and_moves_its_arm(tmp_path):
+    proc = run_check(tmp_path, os.path.join(ROOT, "urdf", "diffbot_arm.urdf.xacro"),
+                     os.path.join(ROOT, "config", "diffbot_arm_control.yaml"), timeout=120)
+    out = proc.stdout
+    assert proc.returncode == 0, out + proc.stderr
+    lines = out.splitlines()
+    assert len(lines) <= 50, out
+    # each transmission joint: interface and control method, limits (URDF), controller (YAML), role
+    assert "joints with a transmission: 8" in lines
+    assert ("  shoulder_pitch_joint: revolute, PositionJointInterface (position, pid_gains p 20), [-1.8, 1.8] rad, "
+            "1.5 rad/s, 6 N·m; arm_controller (position_controllers/JointTrajectoryController)") in lines, out
+    assert ("  left_finger_joint: prismatic, EffortJointInterface (effort), [0, 0.035] m, 0.1 m/s, 10 N; "
+            "gripper_controller (effort_controllers/GripperActionController)") in lines, out
+    assert any(line.startswith("  right_finger_joint: ") and line.endswith("mimic of left_finger_joint (plugin)")
+               for line in lines), out
+    assert any(line.startswith("  left_wheel_joint: ") and line.endswith("drive wheel") for line in lines), out
+    assert not any("NOT simulated  controller" in line for line in lines), out
+    # every arm joint moved out and back by its controller, the body judged each time
+    moves = [line for line in lines if line.startswith(("  arm_controller ", "  gripper_controller "))]
+    assert len(moves) == 4 and all(line.endswith(": PASS") for line in moves), out
+    assert all(joint in moves[0] for joint in ("shoulder_yaw_joint", "shoulder_pitch_joint", "elbow_joint",
+                                               "wrist_joint")), out
+    assert "left_finger_joint" in moves[2], out
+    assert lines[-1] == "result: PASS: the robot drives and its arm joints move as commanded"
+
+
+def test_an_arm_joint_that_cannot_move_fails(tmp_path):
+    # arm_frozen_joint: joint_2's URDF <limit velocity="0"> rate-limits its position commands to nothing
+    proc = run_check(tmp_path, os.path.join(ROBOTS, "arm_frozen_joint.urdf"),
+                     os.path.join(ROBOTS, "arm_position_pid.yaml"), timeout=90)
+    out = proc.stdout
+    assert proc.returncode == 1, out + proc.stderr
+    lines = out.splitlines()
+    assert any(line.startswith("  joint_2: revolute, PositionJointInterface") and ", 0 rad/s, " in line
+               for line in lines), out
+    out_move = next(line for line in lines if line.startswith("  arm_controller out: "))
+    assert out_move.endswith(": FAIL") and "ABORTED" in out_move, out
+    assert any(line.startswith("    joint_2 at ") and "sent to" in line for line in lines), out
+    assert lines[-1] == "result: FAIL: the arm does not move as commanded (ground truth)"

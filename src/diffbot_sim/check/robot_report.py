@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import List, Optional, Tuple
 
 from diffbot_sim import config as cfgmod
+from diffbot_sim.check import arm_report
 from diffbot_sim.control import diff_drive_config as ddc
 from diffbot_sim.control.controller_lookup import find_controllers
 from diffbot_sim.description import meshes
@@ -31,6 +32,11 @@ NO_DRIVE = ("the model has no drive plugin or controller that bullet_sim simulat
             "nothing moves it")
 #: Loaded and URDF mass may differ by this much [kg] (an inertia-less root weighs 1 mg in PyBullet).
 MASS_TOLERANCE = 1e-3
+#: Controller types known simulated when the caller passes none (the node passes the controller manager's).
+DEFAULT_CONTROLLER_TYPES = frozenset((ddc.CONTROLLER_TYPE, "joint_state_controller/JointStateController",
+                                      "velocity_controllers/JointVelocityController",
+                                      "position_controllers/JointPositionController",
+                                      "effort_controllers/JointEffortController"))
 
 
 @dataclass
@@ -72,6 +78,16 @@ class Report:
     #: m: the middle of the first drive's wheel centres in the root link's frame (x, y), which turns in place
     wheel_centre: Tuple[float, float] = (0.0, 0.0)
     footprint: Optional[Tuple[float, float]] = None  # m: those wheels' farthest |x|, |y| from that middle
+    #: every transmission joint: interface, limits, controller, role (check.arm_report.JointInfo)
+    joints: List[arm_report.JointInfo] = field(default_factory=list)
+    model: object = None  # the parsed URDF (description.urdf_model.RobotModel)
+    control_ns: str = "/"  # gazebo_ros_control's robotNamespace
+    controllers: dict = field(default_factory=dict)  # {controller namespace: parameters} found under it
+
+    @property
+    def arm_joints(self):
+        """Transmission joints that are neither drive wheels nor mimic joints."""
+        return [j for j in self.joints if j.arm]
 
     @property
     def skid(self):
@@ -112,7 +128,7 @@ def _update(node, values):
 # --------------------------------------------------------------------------------------------- report
 
 def build_report(path, model_args="", controller_files=(), known=(), known_sensors=(), resolve_package=None,
-                 cache_dir=None):
+                 cache_dir=None, known_controllers=None):
     """Load ``path`` as bullet_sim would and describe it.
 
     Args:
@@ -125,6 +141,8 @@ def build_report(path, model_args="", controller_files=(), known=(), known_senso
         resolve_package: ``pkg -> path`` for ``package://`` meshes (LookupError when unknown); None: every
             package is unknown.
         cache_dir: converted-mesh cache; None: the user's (``meshes.default_cache_dir()``).
+        known_controllers: controller types the simulator runs (the controller manager's); None: the
+            diff-drive, joint-state and single-joint forward controllers.
 
     Returns:
         Report.
@@ -149,7 +167,9 @@ def build_report(path, model_args="", controller_files=(), known=(), known_senso
             origin[ns] = os.path.basename(name)
 
     warnings = list(found.warnings)
+    known_controllers = DEFAULT_CONTROLLER_TYPES if known_controllers is None else frozenset(known_controllers)
     drives, items = [], []
+    control_ns, control_controllers, mimics = "/", {}, []
     block = found.diff_drive
     if block is not None:
         drives.append(_diff_drive(model, block, warnings))
@@ -162,6 +182,7 @@ def build_report(path, model_args="", controller_files=(), known=(), known_senso
         if other.filename not in known:
             continue
         values = {child.tag: tag_value(child) for child in other.element}
+        mimics += arm_report.mimic_pairs([(other.filename, values)])
         if other.filename == SKID_STEER:
             drives.append(_skid_steer(model, values, other.path, warnings))
         elif other.filename == KOBUKI:
@@ -174,15 +195,13 @@ def build_report(path, model_args="", controller_files=(), known=(), known_senso
             if sim_type != DEFAULT_SIM_TYPE:
                 warnings.append(f"{other.path}: robotSimType '{sim_type}' is not simulated; using {DEFAULT_SIM_TYPE}")
             controllers = find_controllers(tree, ns)
+            control_ns, control_controllers = ns, controllers
             if not controllers:
                 warnings.append(f"{other.path}: no controller found on the parameter server under {ns} (load "
                                 "your controller YAML with <rosparam command=\"load\"> before bullet_sim starts)")
             for name, params in sorted(controllers.items()):
                 kind = params.get("type")
-                simulated = kind in (ddc.CONTROLLER_TYPE, "joint_state_controller/JointStateController",
-                                     "velocity_controllers/JointVelocityController",
-                                     "position_controllers/JointPositionController",
-                                     "effort_controllers/JointEffortController")
+                simulated = kind in known_controllers
                 file = origin.get(name, "?")
                 items.append(Item("controller", name, kind, f"from {file}", simulated))
                 if not simulated:
@@ -213,8 +232,10 @@ def build_report(path, model_args="", controller_files=(), known=(), known_senso
         warnings.append("not simulated (ignored): " + "; ".join(found.unsupported))
     if not drives:
         warnings.append(NO_DRIVE)
+    wheels = {joint for drive in drives for joint in drive.left + drive.right}
+    joints = arm_report.joint_infos(model, tree, control_ns, control_controllers, wheels, mimics)
     return Report(source, model.name, model.total_mass(), loaded_mass, drives, items, _unique(warnings),
-                  rest_height, wheel_centre, footprint)
+                  rest_height, wheel_centre, footprint, joints, model, control_ns, control_controllers)
 
 
 def _footprint(loaded, model, drive):
@@ -349,6 +370,7 @@ def format_report(report, extra_warnings=()):
         mark = "simulated    " if item.simulated else "NOT simulated"
         what = item.what if item.kind != "sensor" else f"type {item.what}"
         lines.append(f"  {mark}  {item.kind} {item.name} ({what}) {item.where}")
+    lines.extend(arm_report.format_joints(report.joints))
     warnings = _unique(list(report.warnings) + list(extra_warnings))
     lines.append(f"warnings bullet_sim logs at start: {len(warnings) or 'none'}")
     for text in warnings[:MAX_WARNINGS]:

@@ -14,8 +14,14 @@ caught late by a varying number of sim steps: turn on odometry 1.82..2.05 rad wi
 straight 0.70..0.78 m with the default 5 ms batches (0.68 m fails); at 3x real time, 1.966..1.975 rad and
 0.790..0.794 m, for about 3 s more wall time (7-8 s in all).
 
-Exit status: 0 when both motions pass, 1 when they do not (or the model or the simulator fails: one line
-naming the file, element or parameter), 2 on bad usage. Every process started is stopped, by its pid and
+A robot with arm joints (transmission joints that are not drive wheels nor mimic joints) has them moved too,
+after the drive: each controller of the YAMLs that commands them (trajectory, gripper action or position
+command) takes its joints a small step and back, and the body is judged by ground truth (every link Gazebo keeps
+against where joint_states + the URDF put it): :mod:`diffbot_sim.nodes._arm_moves`. The report lists every
+transmission joint's interface, limits and controller (:mod:`diffbot_sim.check.arm_report`).
+
+Exit status: 0 when both motions (and the arm's moves) pass, 1 when they do not (or the model or the simulator
+fails: one line naming the file, element or parameter), 2 on bad usage. Every process started is stopped, by its pid and
 its session, before the exit.
 """
 import os
@@ -92,21 +98,22 @@ def main(argv=None):
     try:
         files = [(path, _load_yaml(path)) for path in yamls]
         from diffbot_sim.plugins.registry import KNOWN, KNOWN_SENSORS  # the plugin modules (rospy): here only
+        from diffbot_sim.plugins.ros_control.manager import KNOWN_TYPES
         report = robot_report.build_report(model, model_args, [(p, tree) for p, (tree, _) in files], KNOWN,
-                                           KNOWN_SENSORS, package_path)
+                                           KNOWN_SENSORS, package_path, known_controllers=KNOWN_TYPES)
     except DiffbotSimError as err:
         streams.write(sys.stderr, f"robot_check: {err}\n")
         return 1
     for line in robot_report.format_report(report):
         _say(line)
-    if report.drive is None:
+    if report.drive is None and not report.arm_joints:
         _say("result: FAIL: no drive was found, so there is nothing to drive")
         return 1
     signal.signal(signal.SIGTERM, _terminate)
     try:
         with Session(model, model_args, [docs for _, (_, docs) in files]) as session:
             try:
-                return _drive(session, report)
+                return _check(session, report)
             finally:
                 _leave_ros()  # before the session stops the master this node talks to
     except SessionError as err:
@@ -197,13 +204,53 @@ def _wait(predicate, timeout, what, session):
         time.sleep(0.01)
 
 
+def _check(session, report):
+    """Join the session, drive (when the robot has a drive), move the arm joints (when it has some); the
+    exit status and the final ``result:`` line."""
+    import rospy
+
+    from diffbot_sim.nodes import _arm_moves
+
+    rospy.init_node("robot_check", anonymous=True, argv=[sys.argv[0]], disable_signals=True)
+    _wait(lambda: rospy.has_param(SIM + "/loaded_mass"), START_TIMEOUT, "bullet_sim to load the model", session)
+    verdicts = []
+    if report.drive is not None:
+        verdicts.append(_drive(session, report))
+    if report.arm_joints and (not verdicts or verdicts[0][0]):
+        logged = session.sim_warnings()
+        watchdog = threading.Thread(target=_watch, args=(session, time.monotonic() + DRIVE_TIMEOUT), daemon=True)
+        watchdog.start()
+        try:
+            passed, lines = _arm_moves.check_arm(report, lambda p, t, w: _wait(p, t, w, session))
+        except rospy.ROSInterruptException:
+            raise SessionError(session.sim_failure() or f"the arm check took longer than {DRIVE_TIMEOUT:g} s "
+                               "of wall time (sim time stopped?)") from None
+        for line in lines:
+            _say(line)
+        during = [w for w in session.sim_warnings() if w not in logged and w not in report.warnings]
+        for text in during[:3]:
+            _say(f"  bullet_sim warned while moving the arm: {text}")
+        verdicts.append((passed, "its arm joints move as commanded, the body where joint_states + the URDF "
+                                 "put it" if passed else "the arm does not move as commanded (ground truth)"))
+    failed = [text for ok, text in verdicts if not ok]
+    if failed:
+        _say(f"result: FAIL: {failed[0]}")
+        return 1
+    if report.drive is None:
+        _say(f"result: PASS: {verdicts[0][1]} (no drive)")
+    elif len(verdicts) == 1:
+        _say(f"result: PASS: {verdicts[0][1]}")
+    else:
+        _say("result: PASS: the robot drives and its arm joints move as commanded")
+    return 0
+
+
 def _drive(session, report):
+    """Drive the robot and judge it: (passed, verdict)."""
     import rospy
     from geometry_msgs.msg import Twist
     from nav_msgs.msg import Odometry
 
-    rospy.init_node("robot_check", anonymous=True, argv=[sys.argv[0]], disable_signals=True)
-    _wait(lambda: rospy.has_param(SIM + "/loaded_mass"), START_TIMEOUT, "bullet_sim to load the model", session)
     cmd_topic = rospy.get_param(SIM + "/cmd_vel_topic", None)
     odom_topic = rospy.get_param(SIM + "/odom_topic", None)
     _say(f"drive test (bullet_sim headless, 3x real time): {cmd_topic} -> {odom_topic}, {SIM}/ground_truth")
@@ -263,13 +310,10 @@ def _drive(session, report):
     if len(during) > 3:
         _say(f"  ... and {len(during) - 3} more")
     if not rest.passed:
-        _say("result: FAIL: the robot does not rest upright on the ground before driving (ground truth)")
-        return 1
+        return False, "the robot does not rest upright on the ground before driving (ground truth)"
     if straight.passed and turn.passed and straight_body.passed and turn_body.passed:
-        _say("result: PASS: the robot drives")
-        return 0
-    _say("result: FAIL: the robot does not drive as commanded")
-    return 1
+        return True, "the robot drives"
+    return False, "the robot does not drive as commanded"
 
 
 def _command(pub, linear, angular, seconds):

@@ -53,7 +53,7 @@ class MimicJoint(Plugin):
         (master, mimic), _, _ = robot.joint_states([self.master, self.mimic])
         if self.motor:
             target = self.core.target(master)
-            if math.isfinite(target):
+            if math.isfinite(target) and abs(target - mimic) >= self.core.config.sensitiveness:
                 robot.set_positions([self.mimic], [target], [self.force],
                                     KINEMATIC_POSITION_GAIN if not self.core.config.has_pid else None)
             return
