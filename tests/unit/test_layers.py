@@ -26,8 +26,9 @@ LAYERS = {
     "world": 3, "sensors": 3,
     # the one PyBullet user; gazebo_ros's decisions; pictures
     "physics": 4, "gazebo": 4, "view": 4,
-    # judging a robot (it loads it into physics); ROS messages from numbers
-    "check": 5, "ros": 5,
+    # judging a robot (it loads it into physics); ROS messages from plain numbers, control/'s trajectory
+    # points and world/'s marker specs (message modules only)
+    "check": 5, "messages": 5,
     # running scenario files as processes, here or on Ray (no rospy: a run's ROS processes are children)
     "batch": 5,
     # Gymnasium environments: a robot in a world in-process, through physics/ and the pure models (no rospy)

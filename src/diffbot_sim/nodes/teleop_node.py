@@ -34,8 +34,8 @@ from nav_msgs.msg import Odometry
 
 from diffbot_sim import streams
 from diffbot_sim.errors import ConfigError, TerminalError
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.nodes._entry import entry_point
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.teleop.keymap import BANNER, STOP, Teleop, TeleopConfig, format_status
 from diffbot_sim.teleop.terminal import EOF, StatusLine, raw_terminal, read_key, require_tty
 from diffbot_sim.transforms import yaw_from_quaternion

@@ -33,55 +33,6 @@ from diffbot_sim.errors import DiffbotSimError
 from diffbot_sim.nodes._entry import entry_point
 from diffbot_sim.transforms import quaternion_from_yaw
 from diffbot_sim.world.loading import robot_namespaces, simulator_world
-from diffbot_sim.world.markers import CUBE, CYLINDER, MESH_RESOURCE, SPHERE, TRIANGLE_LIST, marker_specs
-
-_KINDS = {CUBE: 1, SPHERE: 2, CYLINDER: 3, MESH_RESOURCE: 10, TRIANGLE_LIST: 11}  # Marker type constants
-
-
-def make_marker_array(world, frame_id="world", warnings=None):
-    """``world``'s static geometry as a visualization_msgs/MarkerArray in ``frame_id``.
-
-    The first marker is a DELETEALL, so a node restarted with another world leaves no old shape in rviz.
-    Marker ids count from 0 within each namespace (the body's name). Stamps are zero: the geometry holds at
-    every time, and rviz then uses the latest transform instead of waiting for one at a given stamp.
-
-    Args:
-        world: a :class:`diffbot_sim.world.bodies.WorldDescription`.
-        frame_id: the world's frame in TF.
-        warnings: a list that gets one line per thing left out.
-
-    Returns:
-        visualization_msgs.msg.MarkerArray
-    """
-    from geometry_msgs.msg import Point
-    from visualization_msgs.msg import Marker, MarkerArray
-
-    array = MarkerArray()
-    clear = Marker()
-    clear.header.frame_id = frame_id
-    clear.action = Marker.DELETEALL
-    array.markers.append(clear)
-    ids = {}
-    for spec in marker_specs(world, warnings):
-        m = Marker()
-        m.header.frame_id = frame_id
-        m.ns = spec.ns
-        m.id = ids.get(spec.ns, 0)
-        ids[spec.ns] = m.id + 1
-        m.type = _KINDS[spec.kind]
-        m.action = Marker.ADD
-        (m.pose.position.x, m.pose.position.y, m.pose.position.z) = spec.pose[0]
-        (m.pose.orientation.x, m.pose.orientation.y, m.pose.orientation.z, m.pose.orientation.w) = spec.pose[1]
-        (m.scale.x, m.scale.y, m.scale.z) = spec.scale
-        (m.color.r, m.color.g, m.color.b, m.color.a) = spec.color
-        if spec.mesh:
-            m.mesh_resource = spec.mesh
-            m.mesh_use_embedded_materials = False
-        if spec.kind == TRIANGLE_LIST:
-            m.points = [Point(float(x), float(y), float(z)) for x, y, z in spec.points]
-        m.frame_locked = False
-        array.markers.append(m)
-    return array
 
 
 def odom_offset(source, x, y, yaw):
@@ -130,8 +81,10 @@ def main():
     """Entry point of ``rosrun diffbot_sim world_markers``."""
     import rospy
     import tf2_ros
-    from geometry_msgs.msg import TransformStamped
     from visualization_msgs.msg import MarkerArray
+
+    from diffbot_sim.messages.common import transform_stamped
+    from diffbot_sim.messages.markers import marker_array
 
     rospy.init_node("world_markers")
     sim = rospy.get_param("~sim", "/bullet_sim").rstrip("/")
@@ -142,11 +95,11 @@ def main():
         world = simulator_world(sim, rospy.get_param)
         warnings = []
         if world is not None:
-            array = make_marker_array(world, frame_id, warnings)
+            array = marker_array(world, frame_id, warnings)
             for text in warnings:
                 rospy.logwarn("world_markers: " + text)
         else:
-            array = make_marker_array(_Empty(), frame_id)
+            array = marker_array(_Empty(), frame_id)
         pub.publish(array)
         rospy.loginfo(f"world_markers: {len(array.markers) - 1} markers in frame {frame_id}"
                       + (f" from {world.source}" if world is not None else " (no ~world: ground plane only)"))
@@ -155,15 +108,7 @@ def main():
         rospy.logfatal(str(err))
         return 1
     broadcaster = tf2_ros.StaticTransformBroadcaster()
-    transforms = []
-    for child, ((x, y, z), (qx, qy, qz, qw)) in frames:
-        t = TransformStamped()
-        t.header.frame_id = frame_id
-        t.child_frame_id = child
-        t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = x, y, z
-        (t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z,
-         t.transform.rotation.w) = qx, qy, qz, qw
-        transforms.append(t)
+    transforms = [transform_stamped(frame_id, child, pose) for child, pose in frames]
     broadcaster.sendTransform(transforms)
     rospy.loginfo("world_markers: " + ", ".join(f"{frame_id} -> {t.child_frame_id}" for t in transforms))
     rospy.spin()

@@ -52,7 +52,7 @@ def finite_twist(ctx, msg, owner):
     """The six Twist fields of ``msg``, or None (with a throttled warning) when one is not finite: a NaN
     must never reach the physics, and the robot keeps its last valid command, as diff_drive_controller."""
     from diffbot_sim.control.gazebo_diff_drive import non_finite_field
-    from diffbot_sim.ros import messages as ros_msgs
+    from diffbot_sim.messages import common as ros_msgs
 
     values = ros_msgs.twist_values(msg)
     bad = non_finite_field(values)

@@ -17,10 +17,10 @@ CPU TinyRenderer) or ``egl`` (OpenGL off screen; falls back to tiny with one war
 """
 from sensor_msgs.msg import CameraInfo, Image
 
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import summary_key
 from diffbot_sim.plugins.camera_base import CameraBase
 from diffbot_sim.plugins.depth import DepthCamera
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.sensors import camera as cam
 
 

@@ -16,9 +16,9 @@ import math
 import numpy as np
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import summary_key
 from diffbot_sim.plugins.camera_base import CameraBase
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.sensors import camera as cam
 
 

@@ -17,8 +17,8 @@ from nav_msgs.msg import Odometry
 from diffbot_sim import config as cfgmod
 from diffbot_sim.control.gazebo_diff_drive import DiffDriveController
 from diffbot_sim.control.odometry import EncoderOdometry
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import Plugin, finite_twist, join, next_due
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.transforms import quaternion_from_yaw
 
 

@@ -17,8 +17,8 @@ from diffbot_sim.control import force_based_move as fbm
 from diffbot_sim.description.plugin_tags import plugin_filename
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import PluginNotLoaded
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import Plugin, finite_twist, join
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.transforms import quaternion_from_yaw, rotate
 
 #: The gain tags, in the order of the pure module's gains (x, y, yaw).

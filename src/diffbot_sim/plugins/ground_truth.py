@@ -2,8 +2,8 @@
 Gazebo's p3d plugin gives them; for judging odometry. Enabled by ``~publish_ground_truth``."""
 from nav_msgs.msg import Odometry
 
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import Plugin
-from diffbot_sim.ros import messages as ros_msgs
 
 
 class GroundTruth(Plugin):

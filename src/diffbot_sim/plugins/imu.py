@@ -39,8 +39,8 @@ from sensor_msgs.msg import Imu
 from diffbot_sim.description.plugin_tags import read_tags, vector
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ModelError, PluginNotLoaded
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import Plugin, join, summary_key
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.sensors import noise
 from diffbot_sim.transforms import qconj, qmul, qnormalize, rpy_quaternion
 from diffbot_sim.values import check_bool, tag_number

@@ -6,8 +6,8 @@ Tags and defaults: :class:`diffbot_sim.config.JointStateConfig`.
 from sensor_msgs.msg import JointState
 
 from diffbot_sim import config as cfgmod
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import Plugin, join
-from diffbot_sim.ros import messages as ros_msgs
 
 
 class JointStatePublisher(Plugin):

@@ -26,9 +26,9 @@ from std_msgs.msg import Empty
 from diffbot_sim.control.kinematics import wheel_speeds
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ModelError
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import Plugin, finite_twist, join
 from diffbot_sim.plugins.joint_motors import UNLIMITED_EFFORT
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.transforms import quaternion_from_yaw
 from diffbot_sim.values import check_bool, check_string, tag_number
 

@@ -23,9 +23,9 @@ casting is ``World.ray_batch``. As gazebo_ros does:
 from sensor_msgs.msg import LaserScan, PointCloud, PointCloud2, Range
 
 from diffbot_sim.errors import ConfigError
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins import ray_base
 from diffbot_sim.plugins.base import join
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.sensors import ray as ray_sensor
 from diffbot_sim.values import check_string, tag_number
 

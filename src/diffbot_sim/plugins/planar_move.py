@@ -26,8 +26,8 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
 from diffbot_sim.description.urdf_model import tag_value
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import Plugin, finite_twist, join
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.values import check_bool, check_string, tag_number
 
 #: The most a step's makeup may add to the command: the commanded speed (linear, m/s) and yaw rate (rad/s), each

@@ -13,9 +13,9 @@ warning; gazebo_ros says ``/world``); ``radiation`` (``ultrasound``, anything el
 """
 from sensor_msgs.msg import Range as RangeMsg
 
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins import ray_base
 from diffbot_sim.plugins.base import join
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.sensors import ray as ray_sensor
 from diffbot_sim.values import check_string, tag_number
 

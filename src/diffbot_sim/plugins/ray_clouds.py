@@ -16,9 +16,9 @@ sensor_msgs/PointCloud2 with x, y, z, intensity, ring, time). Casting and range 
 import numpy as np
 from sensor_msgs.msg import PointCloud, PointCloud2
 
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins import ray_base
 from diffbot_sim.plugins.base import join
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.values import check_bool, tag_number
 
 BLOCK = "libgazebo_ros_block_laser.so"

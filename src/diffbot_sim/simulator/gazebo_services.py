@@ -19,8 +19,6 @@ import tempfile
 import rospy
 from gazebo_msgs import msg as gmsg
 from gazebo_msgs import srv as gsrv
-from geometry_msgs.msg import Pose, Twist, Vector3
-from std_msgs.msg import Header
 from std_srvs.srv import Empty
 
 from diffbot_sim.description import meshes
@@ -28,6 +26,7 @@ from diffbot_sim.description.model_files import package_path
 from diffbot_sim.errors import DiffbotSimError
 from diffbot_sim.gazebo import model_xml, world_api
 from diffbot_sim.gazebo.world_api import RequestError
+from diffbot_sim.messages import gazebo as gazebo_messages
 from diffbot_sim.plugins.base import close_handle, publisher
 from diffbot_sim.simulator.gazebo_models import (
     ActorModelEntity,
@@ -40,29 +39,6 @@ from diffbot_sim.transforms import compose
 
 #: Time a spawn may take on the loop (mesh conversion of a large model), before the caller gives up.
 SPAWN_TIMEOUT = 60.0
-
-
-def _pose_tuple(msg):
-    p, q = msg.position, msg.orientation
-    return (p.x, p.y, p.z), (q.x, q.y, q.z, q.w)
-
-
-def _twist_tuple(msg):
-    return (msg.linear.x, msg.linear.y, msg.linear.z), (msg.angular.x, msg.angular.y, msg.angular.z)
-
-
-def _pose_msg(pose):
-    msg = Pose()
-    (msg.position.x, msg.position.y, msg.position.z) = pose[0]
-    (msg.orientation.x, msg.orientation.y, msg.orientation.z, msg.orientation.w) = pose[1]
-    return msg
-
-
-def _twist_msg(twist):
-    msg = Twist()
-    (msg.linear.x, msg.linear.y, msg.linear.z) = twist[0]
-    (msg.angular.x, msg.angular.y, msg.angular.z) = twist[1]
-    return msg
 
 
 class GazeboApi:
@@ -114,14 +90,9 @@ class GazeboApi:
         models = self._publish_model_states() if self.model_states_pub.get_num_connections() else None
         if self.link_states_pub.get_num_connections():
             models = models or self.models()
-            msg = gmsg.LinkStates()
-            for name, entity in models.items():
-                for link in entity.links():
-                    pose, linear, angular = entity.motion(link)
-                    msg.name.append(f"{name}::{link}")
-                    msg.pose.append(_pose_msg(pose))
-                    msg.twist.append(_twist_msg((linear, angular)))
-            self.link_states_pub.publish(msg)
+            self.link_states_pub.publish(gazebo_messages.link_states(
+                (f"{name}::{link}", *entity.motion(link)) for name, entity in models.items()
+                for link in entity.links()))
 
     def publish_if_changed(self, now, stamp):
         """While sim time is held (``~wait_for_nodes``), a spawn or delete is published in model_states at once:
@@ -132,13 +103,8 @@ class GazeboApi:
 
     def _publish_model_states(self):
         models = self.models()
-        msg = gmsg.ModelStates()
-        for name, entity in models.items():
-            pose, linear, angular = entity.motion()
-            msg.name.append(name)
-            msg.pose.append(_pose_msg(pose))
-            msg.twist.append(_twist_msg((linear, angular)))
-        self.model_states_pub.publish(msg)
+        self.model_states_pub.publish(gazebo_messages.model_states(
+            (name, *entity.motion()) for name, entity in models.items()))
         return models
 
     # -- models ------------------------------------------------------------------------------------
@@ -257,7 +223,7 @@ class GazeboApi:
         if name in self.models():
             raise RequestError(f"SpawnModel: Failure - entity '{name}' already exists.")
         kind = model_xml.model_xml_kind(req.model_xml)
-        pose = world_api.check_pose(_pose_tuple(req.initial_pose), "initial_pose")
+        pose = world_api.check_pose(gazebo_messages.pose_tuple(req.initial_pose), "initial_pose")
         frame = self._frame_motion(req.reference_frame, "reference_frame")
         if frame is not None:
             pose = compose(frame[0], pose)
@@ -319,9 +285,9 @@ class GazeboApi:
             frame = self._frame_motion(req.relative_entity_name, "GetModelState: relative_entity_name")
             pose, twist = self._relative(entity.motion(), frame)
             self.seq[req.model_name] = self.seq.get(req.model_name, 0) + 1
-            response.header = Header(seq=self.seq[req.model_name], stamp=self.sim.stamp(),
-                                     frame_id=req.relative_entity_name)
-            response.pose, response.twist = _pose_msg(pose), _twist_msg(twist)
+            response.header = gazebo_messages.state_header(self.seq[req.model_name], self.sim.stamp(),
+                                                           req.relative_entity_name)
+            response.pose, response.twist = gazebo_messages.pose_msg(pose), gazebo_messages.twist_msg(twist)
             return "GetModelState: got properties"
         return self._run(action, response)
 
@@ -330,8 +296,8 @@ class GazeboApi:
         entity = self._model(name, "SetModelState: model")
         if link is not None and link not in entity.links():
             raise RequestError(f"link '{name}::{link}' does not exist")
-        pose = world_api.check_pose(_pose_tuple(pose_msg), "pose")
-        twist = world_api.check_twist(_twist_tuple(twist_msg), "twist")
+        pose = world_api.check_pose(gazebo_messages.pose_tuple(pose_msg), "pose")
+        twist = world_api.check_twist(gazebo_messages.twist_tuple(twist_msg), "twist")
         frame = self._frame_motion(frame_name, "reference_frame")
         pose, (linear, angular) = self._absolute(pose, twist, frame)  # directions turned, as SetModelState
         entity.set_motion(pose, linear, angular, link)
@@ -373,8 +339,7 @@ class GazeboApi:
                 raise RequestError(f"GetLinkState: link '{req.link_name}' does not exist")
             frame = self._frame_motion(req.reference_frame, "GetLinkState: reference_frame")
             pose, twist = self._relative(entity.motion(link), frame)
-            response.link_state = gmsg.LinkState(link_name=req.link_name, pose=_pose_msg(pose),
-                                                 twist=_twist_msg(twist), reference_frame=req.reference_frame)
+            response.link_state = gazebo_messages.link_state(req.link_name, pose, twist, req.reference_frame)
             return "GetLinkState: got state"
         return self._run(action, response)
 
@@ -425,7 +390,7 @@ class GazeboApi:
             response.time_step = values["time_step"]
             response.pause = values["pause"]
             response.max_update_rate = values["max_update_rate"]
-            response.gravity = Vector3(*values["gravity"])
+            response.gravity = gazebo_messages.vector3(values["gravity"])
             for key, value in values["ode_config"].items():
                 setattr(response.ode_config, key, value)
             return "GetPhysicsProperties: got properties"

@@ -11,9 +11,9 @@ from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.physics import World
 from diffbot_sim.plugins.base import next_due, publisher
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.simulator.sync import NodeSync
 from diffbot_sim.simulator.throttle import Throttle
 

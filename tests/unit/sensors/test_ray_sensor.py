@@ -334,7 +334,7 @@ def test_laserscan_bytes_match_genpy():
     import genpy
     from sensor_msgs.msg import LaserScan
 
-    from diffbot_sim.ros import messages as ros_msgs
+    from diffbot_sim.messages import common as ros_msgs
 
     builder = ros_msgs.LaserScanBuilder("robot1/laser", 0.0, 6.28319, 6.28319 / 359, 0.12, 10.0)
     ranges = np.array([1.5, math.inf, -math.inf, 0.25])
@@ -359,7 +359,7 @@ def test_range_and_pointcloud2_builders():
     import genpy
     from sensor_msgs.msg import PointCloud2, Range
 
-    from diffbot_sim.ros import messages as ros_msgs
+    from diffbot_sim.messages import common as ros_msgs
 
     r = ros_msgs.RangeBuilder("sonar", True, 0.1, 0.02, 4.0).build(genpy.Time(1, 0), 2.5)
     assert (r.radiation_type, r.field_of_view, r.min_range, r.max_range, r.range) == (Range.ULTRASOUND, 0.1, 0.02,

@@ -1,5 +1,5 @@
-"""The pure parts of the view: world shapes -> markers, the rviz config for a run, window trees and
-picture analysis (xscreen), with made-up inputs."""
+"""The pure parts of the view: world shapes -> marker specs (their message: tests/unit/messages/test_markers.py),
+the rviz config for a run, window trees and picture analysis (xscreen), with made-up inputs."""
 import math
 
 import numpy as np
@@ -55,17 +55,9 @@ def test_map_walls_are_triangle_lists_with_a_limit():
     assert warnings and "3 wall triangles, 2 drawn" in warnings[0]
 
 
-def test_marker_array_message():
-    from visualization_msgs.msg import Marker
+def test_odom_offset_is_the_spawn_pose_for_encoder_odometry_only():
+    from diffbot_sim.nodes.world_markers import odom_offset
 
-    from diffbot_sim.nodes.world_markers import make_marker_array, odom_offset
-
-    array = make_marker_array(world(), "world")
-    assert array.markers[0].action == Marker.DELETEALL
-    cube = array.markers[1]
-    assert (cube.type, cube.header.frame_id, cube.ns, cube.id) == (Marker.CUBE, "world", "wall::link", 0)
-    assert (cube.pose.position.x, cube.scale.y, cube.color.r) == (3.0, 0.2, 1)
-    assert array.markers[3].type == Marker.MESH_RESOURCE and array.markers[3].mesh_resource == "file:///m/ring.dae"
     assert odom_offset("world", 1, 2, 0.5) == ((0, 0, 0), (0, 0, 0, 1))
     p, q = odom_offset("encoder", 1, 2, 0.5)
     assert p == (1.0, 2.0, 0.0) and q[2] == pytest.approx(math.sin(0.25))

@@ -9,9 +9,9 @@ from nav_msgs.msg import Odometry
 
 from diffbot_sim.control import diff_drive_config as ddc_cfg
 from diffbot_sim.control.diff_drive_controller import DiffDriveControllerCore
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import join
 from diffbot_sim.plugins.ros_control.controller import Controller
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.transforms import quaternion_from_yaw
 
 

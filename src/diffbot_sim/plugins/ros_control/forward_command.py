@@ -12,9 +12,9 @@ import rospy
 from std_msgs.msg import Float64, Float64MultiArray
 
 from diffbot_sim.control import forward_command as fwd
+from diffbot_sim.messages import controllers as control_messages
 from diffbot_sim.plugins.base import join
 from diffbot_sim.plugins.ros_control.controller import Controller
-from diffbot_sim.ros import control_messages
 
 
 class ForwardCommandController(Controller):

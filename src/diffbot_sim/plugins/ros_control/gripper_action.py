@@ -6,9 +6,9 @@ the default ``max_effort``. The logic is :mod:`diffbot_sim.control.gripper_actio
 import rospy
 
 from diffbot_sim.control import gripper_action_controller as gac
+from diffbot_sim.messages import controllers as cm
 from diffbot_sim.plugins.base import join
 from diffbot_sim.plugins.ros_control.controller import Controller, action_server
-from diffbot_sim.ros import control_messages as cm
 
 INTERFACES = {"position": "PositionJointInterface", "effort": "EffortJointInterface"}
 

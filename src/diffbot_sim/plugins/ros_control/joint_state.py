@@ -4,9 +4,9 @@ wheels, casters, fingers a mimic plugin moves: robot_state_publisher needs them 
 positions make TF agree with the body), and ``extra_joints`` with their fixed values."""
 from sensor_msgs.msg import JointState
 
+from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import join, next_due
 from diffbot_sim.plugins.ros_control.controller import Controller
-from diffbot_sim.ros import messages as ros_msgs
 from diffbot_sim.values import check_number
 
 

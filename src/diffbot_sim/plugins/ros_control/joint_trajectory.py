@@ -20,9 +20,9 @@ from trajectory_msgs.msg import JointTrajectory
 
 from diffbot_sim.control import joint_trajectory_controller as jtc
 from diffbot_sim.errors import ConfigError
+from diffbot_sim.messages import controllers as cm
 from diffbot_sim.plugins.base import join, next_due
 from diffbot_sim.plugins.ros_control.controller import Controller, action_server
-from diffbot_sim.ros import control_messages as cm
 
 INTERFACES = {"position": "PositionJointInterface", "velocity": "VelocityJointInterface",
               "effort": "EffortJointInterface"}

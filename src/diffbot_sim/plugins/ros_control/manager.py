@@ -77,20 +77,34 @@ class ControllerManager:
         return controller
 
     def switch(self, start, stop, strictness):
-        """SwitchController: stop, then start."""
+        """SwitchController: stop, then start. A controller that refuses to start (upstream's controller_manager
+        would crash there) undoes the switch: the ones it stopped run again, so an arm is never left unheld."""
         claims = {n: c.joints() for n, c in self.loaded.items()}
         running = [n for n, c in self.loaded.items() if c in self.running]
         to_stop, to_start = switching.plan_switch(self.loaded, running, claims, start, stop, strictness)
         now = self.ctx.sim.sim_time
         for name in to_stop:
-            controller = self.loaded[name]
-            self.running.remove(controller)
-            controller.stop(now)
+            self._stop(name, now)
         self.hw.read()
-        for name in to_start:
-            controller = self.loaded[name]
-            controller.start(now)
-            self.running.append(controller)
+        started = []
+        try:
+            for name in to_start:
+                self.loaded[name].start(now)
+                self.running.append(self.loaded[name])
+                started.append(name)
+        except Exception:
+            for name in reversed(started):
+                self._stop(name, now)
+            self.hw.read()
+            for name in to_stop:
+                self.loaded[name].start(now)
+                self.running.append(self.loaded[name])
+            raise
+
+    def _stop(self, name, now):
+        controller = self.loaded[name]
+        self.running.remove(controller)
+        controller.stop(now)
 
     def unload(self, name):
         """UnloadController: a stopped controller goes, with its topics, services and actions."""

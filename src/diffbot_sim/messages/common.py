@@ -1,11 +1,12 @@
-"""The only place message objects are built (message modules only; no rospy).
+"""The common_msgs (geometry, nav, sensor), tf2_msgs and rosgraph_msgs messages the plugins and the loop
+publish, built from plain numbers (message modules only; no rospy).
 
 The simulator publishes four messages per control period, thousands per wall second in fast mode, so its
 builders reuse one message object each and serialize it with a few precompiled ``struct`` calls instead of
 genpy's field-by-field code. That is safe because rospy serializes inside ``publish()`` on the caller's
 thread, queued publisher or not (rospy/topics.py ``_PublisherImpl.publish``): once ``publish()`` returns,
 the object may be refilled. The packed classes keep their genpy type and md5sum and write the very same
-bytes (tests/unit/test_ros_msgs.py compares them with genpy's own ``serialize``); what never changes
+bytes (tests/unit/messages/test_common.py compares them with genpy's own ``serialize``); what never changes
 (frames, joint names, covariance) is packed once per builder. The subclasses declare no ``__slots__`` on
 purpose: genpy reads ``self.__slots__`` for the field list (printing, equality, keyword construction).
 """
@@ -99,13 +100,18 @@ class OdometryBuilder:
         """The builder's message, refilled: publish it before the next build()."""
         msg = self.msg
         msg.header.stamp = stamp
-        p, q = msg.pose.pose.position, msg.pose.pose.orientation
-        p.x, p.y, p.z = position
-        q.x, q.y, q.z, q.w = orientation
-        v, w = msg.twist.twist.linear, msg.twist.twist.angular
-        v.x, v.y, v.z = linear
-        w.x, w.y, w.z = angular
+        _fill_motion(msg, position, orientation, linear, angular)
         return msg
+
+
+def _fill_motion(msg, position, orientation, linear, angular):
+    """An Odometry's pose (x, y, z; qx, qy, qz, qw) and twist (linear, angular)."""
+    p, q = msg.pose.pose.position, msg.pose.pose.orientation
+    p.x, p.y, p.z = position
+    q.x, q.y, q.z, q.w = orientation
+    v, w = msg.twist.twist.linear, msg.twist.twist.angular
+    v.x, v.y, v.z = linear
+    w.x, w.y, w.z = angular
 
 
 class PackedTransformStamped(TransformStamped):
@@ -272,6 +278,19 @@ def nav_sat_fix(stamp, frame, latitude, longitude, altitude, covariance=None, st
     return msg
 
 
+def transform_stamped(parent, child, pose, stamp=None):
+    """A plain geometry_msgs/TransformStamped ``parent`` -> ``child`` of ``pose`` ((x, y, z), (qx, qy, qz, qw)),
+    for a static transform (stamp zero unless given); a new object per call, unlike :class:`TransformBuilder`."""
+    msg = TransformStamped()
+    msg.header.frame_id, msg.child_frame_id = parent, child
+    if stamp is not None:
+        msg.header.stamp = stamp
+    t, r = msg.transform.translation, msg.transform.rotation
+    t.x, t.y, t.z = pose[0]
+    r.x, r.y, r.z, r.w = pose[1]
+    return msg
+
+
 def vector3_stamped(stamp, frame, vector):
     msg = Vector3Stamped()
     msg.header.stamp, msg.header.frame_id = stamp, frame
@@ -283,12 +302,7 @@ def odometry(stamp, frame, child, position, orientation, linear, angular, pose_c
     """nav_msgs/Odometry with six-value covariance diagonals (a plain message, for sensors like p3d)."""
     msg = Odometry()
     msg.header.stamp, msg.header.frame_id, msg.child_frame_id = stamp, frame, child
-    p, q = msg.pose.pose.position, msg.pose.pose.orientation
-    p.x, p.y, p.z = position
-    q.x, q.y, q.z, q.w = orientation
-    v, w = msg.twist.twist.linear, msg.twist.twist.angular
-    v.x, v.y, v.z = linear
-    w.x, w.y, w.z = angular
+    _fill_motion(msg, position, orientation, linear, angular)
     msg.pose.covariance = diagonal(pose_covariance)
     msg.twist.covariance = diagonal(twist_covariance)
     return msg

@@ -1,4 +1,4 @@
-"""ros_msgs.py: the packed messages write exactly what genpy writes, and builders refill one object."""
+"""messages/common.py: the packed messages write exactly what genpy writes, and builders refill one object."""
 import io
 
 import genpy
@@ -7,7 +7,7 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
 from tf2_msgs.msg import TFMessage
 
-from diffbot_sim.ros import messages as ros_msgs
+from diffbot_sim.messages import common as ros_msgs
 
 
 def _bytes(serialize, msg):
@@ -71,3 +71,29 @@ def test_packed_types_keep_the_wire_identity():
                           (ros_msgs.PackedTFMessage, TFMessage), (ros_msgs.PackedTransformStamped, TransformStamped)):
         assert (packed._type, packed._md5sum) == (plain._type, plain._md5sum)
         assert issubclass(packed, plain)
+
+
+def test_plain_odometry_has_its_motion_and_six_value_diagonals():
+    msg = ros_msgs.odometry(genpy.Time(3, 0), "world", "robot/base_link", (1.0, 2.0, 0.1),
+                            (0.0, 0.0, 0.6, 0.8), (0.5, -0.1, 0.0), (0.0, 0.0, 0.25), [1, 2, 3, 4, 5, 6],
+                            [0.1] * 6)
+    assert (msg.header.frame_id, msg.child_frame_id, msg.header.stamp.secs) == ("world", "robot/base_link", 3)
+    p, q = msg.pose.pose.position, msg.pose.pose.orientation
+    assert (p.x, p.y, p.z, q.z, q.w) == (1.0, 2.0, 0.1, 0.6, 0.8)
+    assert (msg.twist.twist.linear.x, msg.twist.twist.linear.y, msg.twist.twist.angular.z) == (0.5, -0.1, 0.25)
+    assert msg.pose.covariance[0] == 1.0 and msg.pose.covariance[35] == 6.0 and msg.pose.covariance[1] == 0.0
+    assert msg.twist.covariance[7] == 0.1
+    again = ros_msgs.odometry(genpy.Time(4, 0), "world", "b", (0, 0, 0), (0, 0, 0, 1), (0, 0, 0), (0, 0, 0),
+                              [0] * 6, [0] * 6)
+    assert again is not msg and msg.pose.pose.position.x == 1.0  # a new message each call
+
+
+def test_a_static_transform_is_a_new_plain_message_with_a_zero_stamp():
+    pose = ((1.0, -2.0, 0.0), (0.0, 0.0, 0.6, 0.8))
+    msg = ros_msgs.transform_stamped("world", "robot1/odom", pose)
+    assert type(msg) is TransformStamped
+    assert (msg.header.frame_id, msg.child_frame_id, msg.header.stamp) == ("world", "robot1/odom", genpy.Time())
+    t, r = msg.transform.translation, msg.transform.rotation
+    assert (t.x, t.y, t.z, r.x, r.y, r.z, r.w) == (1.0, -2.0, 0.0, 0.0, 0.0, 0.6, 0.8)
+    stamped = ros_msgs.transform_stamped("world", "b", pose, stamp=genpy.Time(7, 5))
+    assert stamped.header.stamp == genpy.Time(7, 5) and stamped is not msg

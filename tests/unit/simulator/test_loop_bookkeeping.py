@@ -1,0 +1,187 @@
+"""simulator.loop's bookkeeping without a master: SubscriberLinks (each connection tuned once, corked batches in
+fast mode) and RobotRuntime (what the loop asks a robot, answered from its plugins)."""
+import math
+import socket
+
+from diffbot_sim.simulator.loop import RobotRuntime, SubscriberLinks
+
+
+class Sock:
+    """A TCP socket as SubscriberLinks sees it: it records the options set on it."""
+
+    def __init__(self, family=socket.AF_INET, broken=False):
+        self.family, self.broken = family, broken
+        self.timeouts, self.options = [], []
+
+    def settimeout(self, value):
+        if self.broken:
+            raise OSError("closing")
+        self.timeouts.append(value)
+
+    def setsockopt(self, level, option, value):
+        if self.broken:
+            raise OSError("closing")
+        self.options.append((option, value))
+
+    def corks(self):
+        return [value for option, value in self.options if option == socket.TCP_CORK]
+
+
+class Conn:
+    def __init__(self, sock):
+        self.socket = sock
+
+
+class Impl:
+    def __init__(self, *socks):
+        self.connections = [Conn(s) for s in socks]
+
+
+class Pub:
+    def __init__(self, *socks):
+        self.impl = Impl(*socks)
+
+
+def links_of(pubs, batch=0.002):
+    return SubscriberLinks(lambda: pubs, send_timeout=0.5, batch=batch)
+
+
+def test_each_new_connection_gets_its_timeout_and_nodelay_once():
+    first, second = Sock(), Sock()
+    pubs = [Pub(first)]
+    links = links_of(pubs)
+    links.tune_new(10.0)
+    assert first.timeouts == [0.5] and first.options == [(socket.TCP_NODELAY, 1)]
+    pubs[0].impl.connections.append(Conn(second))
+    links.tune_new(10.05)  # within 0.1 s of the last scan: not looked at
+    assert second.timeouts == []
+    links.tune_new(10.1)
+    assert first.timeouts == [0.5] and second.timeouts == [0.5]
+
+
+def test_only_tcp_sockets_are_tuned_and_a_closing_one_is_skipped():
+    unix, broken, tcp6 = Sock(socket.AF_UNIX), Sock(broken=True), Sock(socket.AF_INET6)
+    gone = Pub()
+    gone.impl = None
+    pubs = [Pub(unix, broken, tcp6), gone, Pub(None)]
+    links = links_of(pubs)
+    links.tune_new(1.0)
+    assert unix.timeouts == [] and tcp6.timeouts == [0.5]
+    assert links._tuned == {broken, tcp6}
+
+
+def test_a_batch_corks_the_scanned_sockets_until_it_is_due():
+    sock = Sock()
+    links = links_of([Pub(sock)], batch=0.002)
+    links.tune_new(1.0)
+    links.hold(1.0)
+    assert sock.corks() == [1] and links.held_since == 1.0
+    links.hold(1.001)  # the batch is open: not corked again
+    links.release_if_due(1.0015)
+    assert sock.corks() == [1] and links.held_since == 1.0
+    links.release_if_due(1.002)
+    assert sock.corks() == [1, 0] and links.held_since is None
+    links.release()  # nothing held: nothing done
+    assert sock.corks() == [1, 0]
+
+
+def test_a_connection_newer_than_the_last_scan_is_not_corked():
+    old, new = Sock(), Sock()
+    pub = Pub(old)
+    links = links_of([pub])
+    links.tune_new(1.0)
+    pub.impl.connections.append(Conn(new))
+    links.hold(1.01)
+    assert old.corks() == [1] and new.corks() == []
+    links.release()
+    assert old.corks() == [1, 0] and new.corks() == []
+
+
+def test_real_time_mode_does_not_batch():
+    sock = Sock()
+    links = links_of([Pub(sock)], batch=0.0)
+    links.tune_new(1.0)
+    links.hold(1.0)
+    assert links.held_since is None and sock.corks() == []
+
+
+def test_a_closed_connection_leaves_the_scan():
+    sock = Sock()
+    pub = Pub(sock)
+    links = links_of([pub])
+    links.tune_new(1.0)
+    pub.impl.connections.clear()
+    links.tune_new(2.0)
+    assert links._tuned == set()
+    links.hold(2.0)
+    assert sock.corks() == []
+
+
+# -- RobotRuntime --------------------------------------------------------------------------------------------
+
+class Plugin:
+    def __init__(self, name, calls, due=math.inf, publish=math.inf, pubs=()):
+        self.name, self.calls, self.due, self.publish, self.pubs = name, calls, due, publish, list(pubs)
+
+    def publishers(self):
+        return self.pubs
+
+    def next_due(self):
+        return self.due
+
+    def next_publish(self):
+        return self.publish
+
+    def before_step(self, now):
+        self.calls.append((self.name, "before", now))
+
+    def after_step(self, now, stamp, transforms):
+        self.calls.append((self.name, "after", now))
+        transforms.append(self.name)
+
+    def reset(self, now):
+        self.calls.append((self.name, "reset", now))
+
+    def start(self, now):
+        self.calls.append((self.name, "start", now))
+
+
+class Context:
+    closed = False
+
+    def close(self):
+        self.closed = True
+
+
+def test_a_robot_without_plugins_is_never_due():
+    runtime = RobotRuntime("r", Context(), [])
+    assert runtime.next_due() == math.inf and runtime.next_publish() == math.inf and runtime.publishers() == []
+
+
+def test_the_robot_is_due_at_its_earliest_plugin():
+    calls = []
+    drive = Plugin("drive", calls, due=0.01, publish=0.02, pubs=["odom", "tf"])
+    laser = Plugin("laser", calls, publish=0.1, pubs=["scan"])
+    runtime = RobotRuntime("r", Context(), [drive, laser])
+    assert runtime.publishers() == ["odom", "tf", "scan"]
+    assert runtime.next_publish() == 0.02
+    assert runtime.next_due() == 0.01
+    drive.due = 0.5
+    assert runtime.next_due() == 0.02  # a publication is due first
+
+
+def test_every_plugin_is_called_in_order_and_close_goes_to_the_context():
+    calls = []
+    ctx = Context()
+    runtime = RobotRuntime("r", ctx, [Plugin("a", calls), Plugin("b", calls)])
+    runtime.start(0.0)
+    runtime.before_step(0.001)
+    transforms = []
+    runtime.after_step(0.002, None, transforms)
+    runtime.reset(0.003)
+    assert calls == [("a", "start", 0.0), ("b", "start", 0.0), ("a", "before", 0.001), ("b", "before", 0.001),
+                     ("a", "after", 0.002), ("b", "after", 0.002), ("a", "reset", 0.003), ("b", "reset", 0.003)]
+    assert transforms == ["a", "b"]  # one list for the step's TF message
+    runtime.close()
+    assert ctx.closed
+

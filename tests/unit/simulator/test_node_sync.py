@@ -1,0 +1,288 @@
+"""simulator.sync.NodeSync's decisions, with fake publishers and fake watched nodes (no master, no /proc).
+
+A fake publisher has rospy's shape as NodeSync reads it: ``impl.seq`` (messages sent) and ``impl.connections``
+(each with the subscriber's ``endpoint_id`` and its ``socket``). Sockets are real socketpairs where a test needs
+to see a subscriber's end closed; a fake node's ``busy`` is set by the test.
+"""
+import socket
+import xmlrpc.client
+
+import pytest
+
+from diffbot_sim.simulator import sync
+from diffbot_sim.simulator.sync import FRESH_GRACE, NodeSync
+
+
+class Conn:
+    def __init__(self, caller, sock=None):
+        self.endpoint_id, self.socket = caller, sock
+
+
+class Impl:
+    def __init__(self):
+        self.seq, self.connections = 0, []
+
+
+class Pub:
+    def __init__(self, name="/scan"):
+        self.resolved_name, self.impl = name, Impl()
+
+    def send(self):
+        """One message published to whoever is connected."""
+        self.impl.seq += 1
+
+
+class Node:
+    """A WatchedNode as NodeSync uses it."""
+
+    def __init__(self, name, busy=False, alive=True):
+        self.name, self.is_busy, self.is_alive, self.dropped, self.closed = name, busy, alive, False, False
+
+    def alive(self):
+        return self.is_alive
+
+    def busy(self, now_wall):
+        return self.is_busy
+
+    def close(self):
+        self.closed = True
+
+
+@pytest.fixture
+def node_sync():
+    """A NodeSync that never asks a master: an unknown caller id is a failure of the test."""
+    warnings = []
+    result = NodeSync(timeout=5.0, ignore=["/rviz*"], own_name="/bullet_sim",
+                      warn=lambda key, text: warnings.append((key, text)))
+    result.warnings = warnings
+    return result
+
+
+def watch(node_sync, *nodes):
+    for node in nodes:
+        node_sync.nodes[node.name] = node
+    return nodes
+
+
+@pytest.fixture
+def pair():
+    """A connected socket pair: (our end, the subscriber's end); closed at the end of the test."""
+    ours, theirs = socket.socketpair()
+    yield ours, theirs
+    ours.close()
+    theirs.close()
+
+
+# -- who was sent a message -------------------------------------------------------------------------------
+
+def test_published_lists_the_publishers_that_sent_since_the_last_call():
+    ns = NodeSync(1.0, [], "/sim", None)
+    scan, cloud, idle = Pub("/scan"), Pub("/cloud"), Pub("/idle")
+    for pub in (scan, cloud, idle):
+        pub.impl.connections.append(Conn("/slam"))
+    ns.published([scan, cloud, idle])  # the first look notes every publisher's count
+    scan.send()
+    cloud.send()
+    assert ns.published([scan, cloud, idle]) == [scan, cloud]
+    assert ns.published([scan, cloud, idle]) == []  # nothing new
+    cloud.send()
+    assert ns.published([scan, cloud, idle]) == [cloud]
+
+
+def test_a_message_nobody_got_is_not_waited_for():
+    ns = NodeSync(1.0, [], "/sim", None)
+    scan, gone = Pub(), Pub("/gone")
+    gone.impl = None  # unregistered
+    scan.send()
+    assert ns.published([scan, gone]) == [] and ns.listeners == {}
+
+
+def test_a_listener_is_fresh_when_it_connected_since_the_previous_message():
+    ns = NodeSync(1.0, [], "/sim", None)
+    scan = Pub()
+    staying = Conn("/slam")
+    scan.impl.connections.append(staying)
+    scan.send()
+    ns.published([scan])
+    assert ns.listeners[scan] == {"/slam": (staying, True)}  # new at the first message
+    one_shot = Conn("/agent")
+    scan.impl.connections.append(one_shot)
+    scan.send()
+    ns.published([scan])
+    assert ns.listeners[scan] == {"/slam": (staying, False), "/agent": (one_shot, True)}
+    assert ns.watched() == {"/slam", "/agent"}
+
+
+def test_connections_leave_out_closed_ends_and_unnamed_ones(pair):
+    ours, theirs = pair
+    scan = Pub()
+    live, unnamed, without_socket = Conn("/slam", ours), Conn(None), Conn("/agent")
+    scan.impl.connections += [live, unnamed, without_socket]
+    assert NodeSync.connections(scan) == {live: "/slam", without_socket: "/agent"}
+    theirs.close()  # the subscriber unsubscribed: rospy has not noticed yet
+    assert NodeSync.connections(scan) == {without_socket: "/agent"}
+    assert NodeSync.connections(scan, peek=False) == {live: "/slam", without_socket: "/agent"}
+    scan.impl = None
+    assert NodeSync.connections(scan) == {}
+
+
+def test_unread_data_from_a_subscriber_is_not_a_closed_end(pair):
+    ours, theirs = pair
+    theirs.sendall(b"x")
+    scan = Pub()
+    scan.impl.connections.append(Conn("/slam", ours))
+    assert list(NodeSync.connections(scan).values()) == ["/slam"]
+
+
+# -- what is still pending ----------------------------------------------------------------------------------
+
+def sent(ns, pub):
+    pub.send()
+    assert ns.published([pub]) == [pub]
+
+
+def test_a_busy_listener_is_pending_and_an_idle_staying_one_is_not(node_sync):
+    scan = Pub()
+    slam, = watch(node_sync, Node("/slam", busy=True))
+    scan.impl.connections.append(Conn("/slam"))
+    sent(node_sync, scan)
+    sent(node_sync, scan)  # a second message: the connection is no longer fresh
+    assert node_sync.pending([scan], 0.0, elapsed=1.0) == [("/slam", "busy")]
+    slam.is_busy = False
+    assert node_sync.pending([scan], 0.0, elapsed=1.0) == []
+
+
+def test_a_fresh_listener_is_given_the_grace_to_drop_its_connection(node_sync):
+    scan = Pub()
+    watch(node_sync, Node("/agent"))
+    scan.impl.connections.append(Conn("/agent"))
+    sent(node_sync, scan)
+    assert node_sync.pending([scan], 0.0, elapsed=0.0) == [
+        ("/agent", "a new subscriber: dropping it after one message?")]
+    assert node_sync.pending([scan], 0.0, elapsed=FRESH_GRACE) == []  # it stays: a subscriber like any other
+
+
+def test_a_step_and_wait_client_is_pending_until_it_subscribes_again(node_sync):
+    scan = Pub()
+    watch(node_sync, Node("/agent"))
+    scan.impl.connections.append(Conn("/agent"))
+    sent(node_sync, scan)
+    scan.impl.connections.clear()  # wait_for_message got its message and unsubscribed
+    assert node_sync.pending([scan], 0.0, elapsed=0.0) == [("/agent", "not subscribed to /scan again yet")]
+    scan.impl.connections.append(Conn("/agent"))  # it acted and waits for the next message: lockstep
+    assert node_sync.pending([scan], 0.0, elapsed=0.0) == []
+
+
+def test_dropped_unwatchable_and_dead_nodes_are_not_waited_for(node_sync):
+    scan = Pub()
+    slow, dead = watch(node_sync, Node("/slow", busy=True), Node("/dead", busy=True, alive=False))
+    slow.dropped = True
+    node_sync.nodes["/remote"] = None  # on another host
+    scan.impl.connections += [Conn("/slow"), Conn("/dead"), Conn("/remote")]
+    sent(node_sync, scan)
+    assert node_sync.pending([scan], 0.0, elapsed=1.0) == []
+    assert dead.closed and "/dead" not in node_sync.nodes  # found again if it comes back
+
+
+def test_after_a_clock_tick_only_busy_nodes_in_the_loop_are_pending(node_sync):
+    scan = Pub()
+    watch(node_sync, Node("/slam", busy=True), Node("/amcl"), Node("/outside", busy=True))
+    scan.impl.connections += [Conn("/slam"), Conn("/amcl")]
+    sent(node_sync, scan)
+    assert node_sync.pending([], 0.0) == [("/slam", "busy")]
+    node_sync.nodes["/slam"].dropped = True
+    assert node_sync.busy_nodes(0.0) == []
+
+
+def test_forget_drops_waits_again_for_a_node_that_subscribed_anew(node_sync):
+    scan = Pub()
+    agent, slam = watch(node_sync, Node("/agent"), Node("/slam"))
+    agent.dropped = slam.dropped = True
+    scan.impl.connections.append(Conn("/slam"))
+    sent(node_sync, scan)
+    sent(node_sync, scan)  # /slam's connection is an old one
+    scan.impl.connections.append(Conn("/agent"))
+    sent(node_sync, scan)
+    node_sync.forget_drops([scan])
+    assert not agent.dropped and slam.dropped
+
+
+# -- holding --------------------------------------------------------------------------------------------------
+
+def test_wait_returns_at_once_when_nothing_is_pending(node_sync):
+    served = []
+    node_sync.wait([], lambda: served.append(1), lambda: False)
+    assert served == [] and node_sync.holds == 1 and node_sync.waited >= 0.0
+
+
+def test_wait_ends_when_told_to_stop(node_sync):
+    scan = Pub()
+    watch(node_sync, Node("/slam", busy=True))
+    scan.impl.connections.append(Conn("/slam"))
+    sent(node_sync, scan)
+    node_sync.wait([scan], lambda: pytest.fail("served after stop"), lambda: True)
+    assert node_sync.warnings == []
+
+
+def test_a_node_past_the_timeout_is_named_once_and_dropped(node_sync):
+    node_sync.timeout = 0.0
+    scan = Pub()
+    slow, = watch(node_sync, Node("/slow", busy=True))
+    scan.impl.connections.append(Conn("/slow"))
+    sent(node_sync, scan)
+    served = []
+    node_sync.wait([scan], lambda: served.append(1), lambda: len(served) > 100)
+    assert slow.dropped and served and len(served) < 100
+    (key, text), = node_sync.warnings
+    assert key == "sync:/slow" and "/slow kept the simulator waiting" in text and "(busy)" in text
+
+
+# -- which nodes can be watched ---------------------------------------------------------------------------------
+
+class Master:
+    uri = "http://localhost:1234/"
+
+    def __init__(self, caller_id):
+        pass
+
+    def lookupNode(self, name):
+        return Master.uri
+
+
+def test_itself_and_ignored_nodes_are_never_looked_up(node_sync, monkeypatch):
+    monkeypatch.setattr(sync.rosgraph, "Master", lambda *a: pytest.fail("the master was asked"))
+    assert node_sync._find("/bullet_sim") is None
+    assert node_sync._find("/rviz_1700000000") is None
+
+
+@pytest.mark.parametrize("uri, code, found", [
+    ("http://localhost:1234/", 1, True),
+    ("http://127.0.0.1:1234/", 1, True),
+    ("http://10.255.255.1:1234/", 1, False),  # another host: its /proc is not ours
+    ("http://localhost:1234/", -1, False),  # getPid refused
+])
+def test_a_local_node_that_reports_its_pid_is_watched(node_sync, monkeypatch, uri, code, found):
+    import os
+
+    class Proxy:
+        def __init__(self, address):
+            assert address == uri
+
+        def getPid(self, caller):
+            return code, "", os.getpid()
+    monkeypatch.setattr(Master, "uri", uri)
+    monkeypatch.setattr(sync.rosgraph, "Master", Master)
+    monkeypatch.setattr(xmlrpc.client, "ServerProxy", Proxy)
+    node = node_sync._find("/slam")
+    assert (node is not None) == found
+    if found:
+        assert (node.name, node.pid, node.dropped) == ("/slam", os.getpid(), False)
+        node.close()
+
+
+def test_a_node_that_does_not_answer_is_not_watched(node_sync, monkeypatch):
+    class Gone(Master):
+        def lookupNode(self, name):
+            raise OSError("connection refused")
+    monkeypatch.setattr(sync.rosgraph, "Master", Gone)
+    assert node_sync._find("/slam") is None
