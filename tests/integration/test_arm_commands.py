@@ -88,6 +88,20 @@ class ArmCommands(unittest.TestCase):
         wait_for(lambda: all(abs(a - b) < tolerance for a, b in zip(self.arm(ns), target)), timeout,
                  f"/{ns} joints at {target} (at {self.arm(ns)})")
 
+    def settled_arm(self, ns, seconds=0.3, tolerance=0.001, timeout=30):
+        """The arm's joints once they have stopped moving (two reads ``seconds`` of sim time apart agree within
+        ``tolerance`` rad or m): a PID-held arm goes on settling after it first reaches its target."""
+        last = [self.arm(ns)]
+
+        def still():
+            sim_sleep(seconds)
+            now = self.arm(ns)
+            done = all(abs(a - b) < tolerance for a, b in zip(now, last[0]))
+            last[0] = now
+            return done
+        wait_for(still, timeout, f"/{ns}'s arm at rest")
+        return last[0]
+
     def assert_still(self, ns, before, what, seconds=0.5, tolerance=0.005):
         sim_sleep(seconds)
         after = self.arm(ns)
@@ -231,7 +245,7 @@ class ArmCommands(unittest.TestCase):
         self.wait_arm(ns, target)
         sim_sleep(0.5)
         self.body_agrees(ns, self.joint_states(ns))
-        before, mark = self.arm(ns), self.rosout.mark()
+        before, mark = self.settled_arm(ns), self.rosout.mark()
         group.publish(Float64MultiArray(data=[0.1, 0.1]))
         self.rosout.wait_line(mark, "position_group", "2")
         self.assert_still(ns, before, "a 2-value command to a 3-joint group")
@@ -275,7 +289,7 @@ class ArmCommands(unittest.TestCase):
 
     def test_h_effort_trajectory_controller_without_gains_is_refused_and_nothing_moves(self):
         ns, manager = "eff", self.managers["eff"]
-        before = self.arm(ns)
+        before = self.settled_arm(ns)
         params = {"type": "effort_controllers/JointTrajectoryController", "joints": JOINTS}
         self.assertTrue(manager.load("arm_nogains", params), "upstream loads it (and logs the missing gains)")
         mark = self.rosout.mark()
@@ -299,7 +313,7 @@ class ArmCommands(unittest.TestCase):
         self.wait_arm(ns, target)
         sim_sleep(0.5)
         self.body_agrees(ns, self.joint_states(ns))
-        before, mark = self.arm(ns), self.rosout.mark()
+        before, mark = self.settled_arm(ns), self.rosout.mark()
         group.publish(Float64MultiArray(data=[0.0, 0.0, 0.0, 0.0]))
         self.rosout.wait_line(mark, "effort_position_group", "4")
         self.assert_still(ns, before, "a 4-value command to a 3-joint group")
@@ -338,7 +352,7 @@ class ArmCommands(unittest.TestCase):
             ("empty", JointTrajectory(joint_names=JOINTS)),
         ]
         for what, msg in cases:
-            before = self.arm(ns)
+            before = self.settled_arm(ns)
             command.publish(msg)
             self.assert_still(ns, before, f"a command with {what}", seconds=1.5)
         command.publish(trajectory(JOINTS, (1.0, [0.0, 0.0, 0.0])))

@@ -86,7 +86,7 @@ class View:
     def start(self):
         rospy.on_shutdown(self.stop)  # rostest ends a test node by signal: leave no X server or rviz behind
         self.xvfb = xscreen.Xvfb().__enter__()
-        self.log_sub = rospy.Subscriber("/rosout_agg", Log, self._keep, callback_args=self.logs, queue_size=1000)
+        self.log_sub = rospy.Subscriber("/rosout", Log, self._keep, callback_args=self.logs, queue_size=1000)
         self.odom_sub = rospy.Subscriber("/odom", Odometry, self._keep, callback_args=self.odom, queue_size=100)
         self.cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
         os.makedirs(self.home, exist_ok=True)
