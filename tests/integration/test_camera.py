@@ -105,10 +105,25 @@ class CameraTest(unittest.TestCase):
 
     def test_images_at_sensor_rate_in_sim_time(self):
         self.wait_for("image", 6)
-        stamps = [m.header.stamp.to_sec() for m in self.rec["image"].all()]
+        msgs = self.rec["image"].all()
+        # Every image published is on the 10 Hz grid of sim time: none early, late or twice. Published messages
+        # are numbered (header.seq), so an image lost on the way here (a loaded machine starves this node's
+        # receiving thread, and its queue of 5 drops the oldest) is a jump in seq, not a late image: each gap
+        # must be 0.1 s per image published.
+        stamps = np.array([m.header.stamp.to_sec() for m in msgs])
+        published = np.diff([m.header.seq for m in msgs])
         gaps = np.diff(stamps)
-        self.assertTrue(np.all(np.abs(gaps - 0.1) < 0.011), f"gaps {gaps}")
-        self.assertLess(abs(stamps[-1] - rospy.get_time()), 1.0)
+        self.assertTrue(np.all(published >= 1), f"images out of order or twice: seq steps {published}")
+        self.assertTrue(np.all(np.abs(gaps - 0.1 * published) < 0.011), f"gaps {gaps} for seq steps {published}")
+        # Stamped in sim time: the next image after the clock's now is stamped within a second of it.
+        now = rospy.get_time()
+        deadline = time.monotonic() + 20.0
+        while not any(m.header.stamp.to_sec() >= now for m in self.rec["image"].all()):
+            if time.monotonic() > deadline or rospy.is_shutdown():
+                self.fail(f"timed out after 20 s waiting for an image stamped after sim time {now:.2f}")
+            time.sleep(0.01)
+        stamp = min(m.header.stamp.to_sec() for m in self.rec["image"].all() if m.header.stamp.to_sec() >= now)
+        self.assertLess(stamp - now, 1.0, f"the first image after sim time {now:.2f} is stamped {stamp:.2f}")
 
     def test_depth_image_reads_the_distance(self):
         info = self.wait_for("depth_info")

@@ -29,6 +29,8 @@ from std_srvs.srv import Empty
 
 GZ = "/gazebo"
 ROBOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "robots", "fixed_caster.urdf")
+DRIVE = 0.6  # m a robot is driven (0.3 m/s for 2 s of sim time)
+DRIVE_TIMEOUT = 60.0  # s wall: 2 s of sim time at 2x real time, on a 4x slower machine
 
 
 def proxy(name, kind):
@@ -65,18 +67,24 @@ class GazeboApiTest(unittest.TestCase):
         self.assertTrue(resp.success, resp.status_message)
         return resp
 
-    def drive(self, ns, linear, angular, seconds_sim):
-        """Publish a command on ``ns``/cmd_vel until sim time has advanced by ``seconds_sim``."""
+    def drive(self, ns, model, linear, distance):
+        """Publish a command on ``ns``/cmd_vel until the body of ``model`` has moved ``distance`` m (its
+        /gazebo/get_model_state), then a zero one. Judged by what the body did, not by a time: on a loaded
+        machine the commands reach the simulator late, and a fixed time moves it less."""
         pub = rospy.Publisher(f"{ns}/cmd_vel", Twist, queue_size=1)
         wait(lambda: pub.get_num_connections() > 0, 10.0, f"{ns}/cmd_vel subscriber")
-        start = rospy.get_time()
+        start = self.model(model).pose.position
         cmd = Twist()
-        cmd.linear.x, cmd.angular.z = linear, angular
-        deadline = time.monotonic() + 60.0
-        while rospy.get_time() < start + seconds_sim and time.monotonic() < deadline:
+        cmd.linear.x = linear
+
+        def moved():
             pub.publish(cmd)
-            time.sleep(0.05)
-        pub.publish(Twist())
+            p = self.model(model).pose.position
+            return math.hypot(p.x - start.x, p.y - start.y) >= distance
+        try:
+            wait(moved, DRIVE_TIMEOUT, f"{model} to drive {distance} m on {ns}/cmd_vel", poll=0.05)
+        finally:
+            pub.publish(Twist())
         return pub
 
     def model(self, name, frame=""):
@@ -107,7 +115,7 @@ class GazeboApiTest(unittest.TestCase):
         self.assertAlmostEqual(start.pose.position.x, 2.0, delta=0.02)
         self.assertAlmostEqual(start.pose.position.y, -3.0, delta=0.02)
         self.assertAlmostEqual(yaw_of(start.pose.orientation), math.pi / 2, delta=0.02)
-        self.drive("/bot1", 0.3, 0.0, 2.0)
+        self.drive("/bot1", "bot1", 0.3, DRIVE)
         end = self.model("bot1")
         assert_upright(end.pose, 0.0, "bot1 after the drive")
         self.assertGreater(end.pose.position.y - start.pose.position.y, 0.3)
@@ -153,7 +161,7 @@ class GazeboApiTest(unittest.TestCase):
         there = self.model("bot_tp")
         self.assertAlmostEqual(there.pose.position.x, 4.0, delta=0.03)
         self.assertAlmostEqual(there.pose.position.y, -6.0, delta=0.03)
-        self.drive("/bot_tp", 0.3, 0.0, 2.0)
+        self.drive("/bot_tp", "bot_tp", 0.3, DRIVE)
         end = self.model("bot_tp")
         assert_upright(end.pose, 0.0, "bot_tp after the teleport and the drive")
         self.assertLess(end.pose.position.x, 4.0 - 0.3, "facing -x after the teleport, it drives towards -x")

@@ -8,7 +8,6 @@ them, all facing +y; the wall's near face is the plane y = 5 (wall.world).
 """
 import math
 import sys
-import time
 import unittest
 
 import rospy
@@ -22,6 +21,8 @@ from simtest import Latest, assert_upright, yaw_of
 from simtest import wait_for as wait
 
 WALL_Y = 5.0
+DRIVE = 0.8  # m each robot drives forward (0.4 m/s for 2 s), judged on its body (/gazebo/get_model_state)
+DRIVE_TIMEOUT = 60.0  # s wall: a drive of 2 s of sim time, on a 4x slower machine
 
 
 class GazeboWayTest(unittest.TestCase):
@@ -87,11 +88,15 @@ class GazeboWayTest(unittest.TestCase):
             wait(lambda: pub.get_num_connections() > 0, 10.0, f"{ns}/mobile_base_controller/cmd_vel subscriber")
             cmd = Twist()
             cmd.linear.x = 0.4
-            t0 = rospy.get_time()
-            deadline = time.monotonic() + 60.0
-            while rospy.get_time() < t0 + 2.0 and time.monotonic() < deadline:
+
+            def driven():
+                """Commanded until the body has moved DRIVE, not for a time: on a loaded machine the commands
+                reach the simulator late (and its cmd_vel_timeout of 0.25 s brakes between late ones)."""
                 pub.publish(cmd)  # the YAML's cmd_vel_timeout is 0.25 s: keep commanding
-                time.sleep(0.05)
+                p = self.state(robot["model"]).pose.position
+                return math.hypot(p.x - start.x, p.y - start.y) >= DRIVE
+            wait(driven, DRIVE_TIMEOUT, f"{robot['model']} to drive {DRIVE} m on {ns}/mobile_base_controller/cmd_vel",
+                 poll=0.05)
             # stopped: the zero command arrives (its cmd_vel_timeout brakes it anyway) before the next robot
             def stopped():
                 pub.publish(Twist())

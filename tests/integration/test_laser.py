@@ -29,6 +29,8 @@ PILLAR = (0.5, 1.2, 0.2)
 
 
 GRAZE = 0.005  # m: a beam this close to an edge (a wall's end, the pillar's silhouette) may go either way
+TURN = 1.0  # rad the body turns left between the two scans compared
+REST_SPEED = 0.005  # m/s and rad/s: the body's ground-truth twist below this is at rest
 
 
 def expected_range(ox, oy, angle, rmax):
@@ -70,6 +72,10 @@ def surface_distance(x, y):
 
 def yaw_of(q):
     return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def wrap(angle):
+    return math.atan2(math.sin(angle), math.cos(angle))
 
 
 def rotate(q, v):
@@ -193,18 +199,16 @@ class LaserTest(unittest.TestCase):
         self.check_projection(scan, pose)
         self.check_sonar(sonar, pose, "at spawn")
 
-        # turn left about 1 rad, stop, settle; the scan turns the other way in the laser's frame
-        start = self.last(self.scans).header.stamp.to_sec()
+        # turn left about 1 rad, stop, settle; the scan turns the other way in the laser's frame. Judged by the
+        # body (ground truth), not by how long it was told to turn: on a loaded machine the first commands
+        # reach the simulator late (or before it subscribes), and its stop late.
+        yaw0 = yaw_of(self.last(self.truth).pose.pose.orientation)
         twist = Twist()
         twist.angular.z = 0.5
-        while self.last(self.scans).header.stamp.to_sec() < start + 2.0:
-            self.cmd.publish(twist)
-            time.sleep(0.05)
-        stop_at = self.last(self.scans).header.stamp.to_sec()
-        for _ in range(5):
-            self.cmd.publish(Twist())
-            time.sleep(0.05)
-        scan2, sonar2, pose2 = self.settled_scan(stop_at + 1.5)
+        self.command_until(twist, lambda: wrap(yaw_of(self.last(self.truth).pose.pose.orientation) - yaw0) >= TURN,
+                           f"the body to turn {TURN} rad left (ground truth)")
+        rest = self.command_until(Twist(), self.at_rest, "the body at rest after the turn (ground truth)")
+        scan2, sonar2, pose2 = self.settled_scan(rest.header.stamp.to_sec())
         laser2, yaw2, pillar2 = self.check_geometry(scan2, pose2, "after turning")
         turned = yaw2 - yaw
         self.assertGreater(turned, 0.3, "the robot turned left")
@@ -214,6 +218,25 @@ class LaserTest(unittest.TestCase):
         self.assertEqual(scan2.intensities[pillar2], 200.0)
         self.check_projection(scan2, pose2)
         self.check_sonar(sonar2, pose2, "after turning")
+
+    def command_until(self, twist, done, what, timeout=60.0):
+        """Publish ``twist`` at 20 Hz (wall) until ``done()`` gives something true (returned); fail naming
+        ``what`` after ``timeout`` wall seconds."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline and not rospy.is_shutdown():
+            self.cmd.publish(twist)
+            value = done()
+            if value:
+                return value
+            time.sleep(0.05)
+        self.fail(f"timed out after {timeout} s waiting for {what}")
+
+    def at_rest(self):
+        """The newest ground truth when it shows the body still (its twist), else None."""
+        msg = self.last(self.truth)
+        twist = msg.twist.twist
+        still = max(abs(twist.linear.x), abs(twist.linear.y), abs(twist.angular.z)) < REST_SPEED
+        return msg if still else None
 
     def check_projection(self, scan, pose):
         """laser_geometry's point cloud (in the laser frame), moved to the world by the known pose, lies on

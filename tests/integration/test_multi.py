@@ -66,10 +66,18 @@ class MultiRobotTest(unittest.TestCase):
 
     def test_2_each_robot_follows_its_own_commands(self):
         rec = self.rec
-        a0, b0 = rec.last(rec.odom), rec.last(rec.extra)
         self.send("robot1", 0.4, 0.0)
         self.send("robot2", 0.0, 1.0)
-        start = a0.header.stamp.to_sec()
+        # Measured from when both bodies answer their commands, not from the newest odom seen before sending:
+        # in fast mode a loaded machine delivers a command sim seconds after that (this node's odom queues up
+        # behind a starved thread), and 3 s "from then" would partly be time before the command.
+        def both():
+            one, two = self.responding(rec.odom, 0.4, 0.0), self.responding(rec.extra, 0.0, 1.0)
+            return (one, two) if one and two else None
+        a0, b0 = rec.wait(both, 30.0, "robot1 to drive at 0.4 m/s and robot2 to turn at 1 rad/s (/robot1/odom, "
+                          "/robot2/odom)")
+        start = max(a0.header.stamp.to_sec(), b0.header.stamp.to_sec())
+        a0, b0 = rec.odom_after(start), rec.odom_after(start, store=rec.extra)
         a1 = rec.odom_after(start + 3.0)
         b1 = rec.odom_after(start + 3.0, store=rec.extra)
         self.send("robot1", 0.0, 0.0)
@@ -91,6 +99,16 @@ class MultiRobotTest(unittest.TestCase):
         self.assertGreater(abs(math.atan2(math.sin(two[-1].yaw - two[0].yaw), math.cos(two[-1].yaw - two[0].yaw))),
                            0.5, "robot2's body turned")
         self.assertLess(math.hypot(two[-1].x - two[0].x, two[-1].y - two[0].y), 0.05, "in place")
+
+    def responding(self, store, linear, angular):
+        """The first odom of ``store`` showing the robot moving as (linear, angular) says (a fifth of each), or
+        None."""
+        for msg in self.rec.snapshot(store):
+            twist = msg.twist.twist
+            if ((linear == 0 or twist.linear.x * linear > 0.2 * linear * linear) and
+                    (angular == 0 or twist.angular.z * angular > 0.2 * angular * angular)):
+                return msg
+        return None
 
     def test_3_tf_tree_per_robot(self):
         """bullet_sim's odom -> base_footprint joins robot_state_publisher's tf_prefix'ed links."""

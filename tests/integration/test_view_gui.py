@@ -19,7 +19,9 @@ must be drawn. Only the part of the 3-D view no panel covers is judged (xscreen.
 """
 import math
 import os
+import subprocess
 import sys
+import time
 
 import numpy as np
 import rospy
@@ -36,10 +38,12 @@ ROOM = os.path.join(viewtest.ROOT, "worlds", "room.world")
 ROBOT = "diffbot"  # the seed robot's URDF name: its model name
 ROBOT_Z = 0.076  # m: the seed robot's body centre above the ground (base_z of diffbot.urdf.xacro)
 AWAY = (30.0, 30.0)  # m: far outside the default camera's view (projects ~8700 px to the right)
-START_TIMEOUT = 40.0  # s wall: master, simulator, PyBullet's window under llvmpipe on a busy 2-core machine
-SETTLE_TIMEOUT = 15.0  # s wall: two equal frames after a change
-SETTLE_PERIOD = 0.5  # s wall between the two frames compared
-SETTLE_CHANGED = 20  # px: "equal" frames differ in at most this many pixels
+START_TIMEOUT = 60.0  # s wall: master, simulator, PyBullet's window under llvmpipe on a 4x slower machine
+SETTLE_TIMEOUT = 60.0  # s wall: PyBullet, drawing a frame every few seconds on a starved machine, shows a change
+CALL_TIMEOUT = 30.0  # s wall: a /gazebo service answers (the loop runs it between steps) on a starved machine
+SETTLE_PERIOD = 0.5  # s wall between screenshots while waiting
+STABLE_WALL = 1.5  # s wall: the window unchanged this long (two screenshots at least): PyBullet has drawn it
+SETTLE_CHANGED = 20  # px: "unchanged" frames differ in at most this many pixels; a change drawn differs in more
 #: Strong pixels of each hue the room must show. Measured on the window's uncovered 3-D view: with the walls
 #: red 16690, yellow 14742, green 8839, blue 25878; after deleting them red 38 (the x axis), yellow 1757 (the
 #: box), green 4215 (the ring), blue 5543 (the pillar, the robot); before the world loads red 137, yellow 0,
@@ -60,8 +64,7 @@ class ViewGui(viewtest.PictureSuite):
                                                         launch="sim.launch")):
             return
         display = cls.view.xvfb.display
-        cls.window = cls.view.wait(lambda: xscreen.find_window(display, "Bullet Physics"), START_TIMEOUT,
-                                   "PyBullet's window")
+        cls.window = cls.view.wait(lambda: cls.find_window(display), START_TIMEOUT, "PyBullet's window")
         # The window opens before the simulator builds the world and the robot: wait for both.
         cls.view.wait(lambda: rospy.has_param("/bullet_sim/world_bodies"), START_TIMEOUT,
                       "the simulator to load the world (/bullet_sim/world_bodies)")
@@ -74,6 +77,14 @@ class ViewGui(viewtest.PictureSuite):
         cls.delete_model = rospy.ServiceProxy("/gazebo/delete_model", DeleteModel)
 
     # ------------------------------------------------------------------------------------- helpers
+
+    @staticmethod
+    def find_window(display):
+        """PyBullet's window, or None (also when xwininfo is too slow to answer: "not yet", not a failure)."""
+        try:
+            return xscreen.find_window(display, "Bullet Physics")
+        except subprocess.TimeoutExpired:
+            return None
 
     @staticmethod
     def service_up(name):
@@ -95,35 +106,110 @@ class ViewGui(viewtest.PictureSuite):
     def call(self, proxy, *args):
         self.view.alive()
         try:
-            return viewtest.with_timeout(lambda: proxy(*args), 10.0, proxy.resolved_name)
+            return viewtest.with_timeout(lambda: proxy(*args), CALL_TIMEOUT, proxy.resolved_name)
         except (rospy.ServiceException, AssertionError):
             self.crashed()
             raise
 
-    def frame(self):
-        """The window's pixels (the window must not have moved or changed size)."""
+    def poll(self, proxy, *args):
+        """``proxy(*args)`` inside a polled wait: the answer, or a sentence saying why there is none (a slow
+        or refused call is "not yet"; roslaunch ending fails at once)."""
         self.view.alive()
-        window = xscreen.find_window(self.view.xvfb.display, "Bullet Physics")
-        if window is None:
-            self.crashed()
-        self.assertIsNotNone(window, "PyBullet's window went away")
-        self.assertEqual((window.width, window.height), xscreen.PYBULLET_WINDOW,
-                         "PyBullet's window is not at its default size: the camera projection does not hold")
-        return xscreen.crop(self.view.screenshot(), window.box())
+        try:
+            return viewtest.with_timeout(lambda: proxy(*args), CALL_TIMEOUT, proxy.resolved_name)
+        except (rospy.ServiceException, AssertionError) as err:
+            return f"{proxy.resolved_name} gave no answer: {err}"
 
-    def settled(self, what):
-        """A frame once two in a row, SETTLE_PERIOD apart, differ in at most SETTLE_CHANGED pixels."""
-        previous = [None]
+    def wait_named(self, ready, timeout, what):
+        """Poll ``ready()``, which returns a true value when done or a sentence saying what is missing; fail
+        naming ``what`` and that sentence (after checking whether roslaunch ended) once ``timeout`` passes."""
+        why = ["nothing polled yet"]
+
+        def check():
+            self.view.alive()
+            value = ready()
+            if isinstance(value, str):
+                why[0] = value
+                return None
+            return value
+        started = time.monotonic()
+        try:
+            value = xscreen.wait_for(check, timeout, what, SETTLE_PERIOD)
+        except AssertionError as err:
+            self.crashed()
+            raise AssertionError(f"{what}: {why[0]} ({err})") from None
+        print(f"view_gui: {what}: {time.monotonic() - started:.1f} s", flush=True)
+        return value
+
+    def frame(self):
+        """The window's pixels, or a sentence saying why there are none (the window missing or not at its
+        default size, for which the camera projection does not hold; a screenshot that failed)."""
+        window = self.find_window(self.view.xvfb.display)
+        if window is None:
+            return "PyBullet's window is not there"
+        if (window.width, window.height) != xscreen.PYBULLET_WINDOW:
+            return (f"PyBullet's window is {window.width}x{window.height}, not its default "
+                    f"{xscreen.PYBULLET_WINDOW[0]}x{xscreen.PYBULLET_WINDOW[1]}: the camera projection does not hold")
+        try:
+            return xscreen.crop(self.view.screenshot(), window.box())
+        except (AssertionError, subprocess.TimeoutExpired) as err:
+            return f"no screenshot: {err}"
+
+    def frame_or_why(self):
+        """``(frame,)`` (a tuple: a wait tests the truth of what it gets), or why there is no frame."""
+        frame = self.frame()
+        return frame if isinstance(frame, str) else (frame,)
+
+    def settled(self, what, before=None, drawn=None):
+        """Wait until PyBullet's window shows the scene as it now is, at rest; return the window's pixels.
+
+        Conditions, the one that never held named in the failure:
+        - the window is there at its default size (missing is "not yet": PyBullet may be remapping it);
+        - with ``before`` (the window before a change: a teleport, a deletion): the 3-D scene differs from it in
+          more than SETTLE_CHANGED pixels, so PyBullet has drawn the change (on a starved machine it redraws
+          seconds late, and screenshots of the old picture are equal to each other);
+        - ``drawn(frame)``, when given, returns None (else a sentence saying what the frame lacks);
+        - the window is the same, but for SETTLE_CHANGED pixels, in every screenshot over STABLE_WALL seconds.
+        """
+        history = []  # (wall time, frame) of the screenshots since the window last changed
 
         def ready():
             frame = self.frame()
-            same = previous[0] is not None and int(xscreen.changed(previous[0], frame).sum()) <= SETTLE_CHANGED
-            previous[0] = frame
-            return (frame,) if same else None  # a tuple: wait_for tests the truth of what it gets
-        return xscreen.wait_for(lambda: self.view.alive() or ready(), SETTLE_TIMEOUT, what, SETTLE_PERIOD)[0]
+            if isinstance(frame, str):
+                history[:] = []
+                return frame
+            if before is not None:
+                redrawn = int(xscreen.changed(self.scene(before), self.scene(frame)).sum())
+                if redrawn <= SETTLE_CHANGED:
+                    history[:] = []
+                    return (f"the scene as before the change ({redrawn} pixels differ, more than {SETTLE_CHANGED} "
+                            "wanted): PyBullet has not drawn it yet, or does not draw what changed")
+            reason = drawn(frame) if drawn is not None else None
+            if reason:
+                history[:] = []
+                return reason
+            history.append((time.monotonic(), frame))
+            moved = max((int(xscreen.changed(old, frame).sum()) for _, old in history[:-1]), default=0)
+            if moved > SETTLE_CHANGED:
+                history[:] = history[-1:]
+                return (f"the window changed in {moved} pixels (more than {SETTLE_CHANGED}) between screenshots: "
+                        "PyBullet still drawing, or something still moving")
+            held = history[-1][0] - history[0][0]
+            if len(history) < 2 or held < STABLE_WALL:
+                return f"the window unchanged for {held:.1f} s of the {STABLE_WALL:g} s wanted"
+            return (frame,)  # a tuple: the wait tests the truth of what it gets
+        return self.wait_named(ready, SETTLE_TIMEOUT, what)[0]
 
     def scene(self, frame):
         return xscreen.crop(frame, xscreen.PYBULLET_SCENE_BOX)
+
+    def walls_missing(self, frame):
+        """None once the scene shows WALL_MIN strong pixels of every hue (the room is drawn), else what it shows:
+        the window opens before the world is built, and on a starved machine is drawn seconds after that."""
+        counts = xscreen.color_counts(self.scene(frame))
+        if all(counts[hue] >= least for hue, least in WALL_MIN.items()):
+            return None
+        return f"the room's colours not drawn yet: {counts} (at least {WALL_MIN} wanted)"
 
     def teleport(self, x, y):
         """Put the robot at (x, y) on the ground (its height and heading kept), at rest; wait until it is."""
@@ -136,9 +222,12 @@ class ViewGui(viewtest.PictureSuite):
         self.assertTrue(answer.success, answer.status_message)
 
         def there():
-            p = self.call(self.get_state, ROBOT, "world").pose.position
-            return math.hypot(p.x - x, p.y - y) < 0.02
-        self.view.wait(there, 10.0, f"the robot at ({x}, {y})")
+            answer = self.poll(self.get_state, ROBOT, "world")
+            if isinstance(answer, str):
+                return answer
+            p = answer.pose.position
+            return math.hypot(p.x - x, p.y - y) < 0.02 or f"the robot at ({p.x:.3f}, {p.y:.3f})"
+        self.wait_named(there, CALL_TIMEOUT, f"the robot at ({x}, {y})")
 
     def robot_patch(self, with_robot, without, label):
         """The pixels the robot changes between two frames: ``(count, centroid, stray)`` over the window."""
@@ -171,7 +260,7 @@ class ViewGui(viewtest.PictureSuite):
         names = self.call(self.world_properties).model_names
         self.assertIn("walls", names)
         self.assertIn(ROBOT, names)
-        frame = self.settled("PyBullet's window to show the world")
+        frame = self.settled("PyBullet's window to show the world", drawn=self.walls_missing)
         viewtest.save_frame(frame, "gui_world")
         counts = xscreen.color_counts(self.scene(frame))
         print(f"view_gui: strong colours with the room: {counts}", flush=True)
@@ -185,11 +274,11 @@ class ViewGui(viewtest.PictureSuite):
         self.assertLess(math.hypot(p.x, p.y), 0.05, f"the robot did not spawn at the origin: {p}")
         at_origin = self.settled("the robot at the origin, drawn")
         self.teleport(*AWAY)
-        away = self.settled("the robot out of view, drawn")
+        away = self.settled("the robot out of view, drawn", before=at_origin)
         self.teleport(1.0, 0.0)
-        at_x1 = self.settled("the robot at (1, 0), drawn")
+        at_x1 = self.settled("the robot at (1, 0), drawn", before=away)
         self.teleport(*AWAY)
-        away_again = self.settled("the robot out of view again, drawn")
+        away_again = self.settled("the robot out of view again, drawn", before=at_x1)
         for image, name in ((at_origin, "origin"), (away, "away"), (at_x1, "x1")):
             viewtest.save_frame(image, f"gui_robot_{name}")
 
@@ -215,11 +304,18 @@ class ViewGui(viewtest.PictureSuite):
         self.view.alive()
 
     def test_3_world_check_fails_without_walls(self):
+        with_walls = self.wait_named(lambda: self.frame_or_why(), SETTLE_TIMEOUT,
+                                     "a screenshot of PyBullet's window before deleting the walls")[0]
         answer = self.call(self.delete_model, "walls")
         self.assertTrue(answer.success, answer.status_message)
-        self.view.wait(lambda: "walls" not in self.call(self.world_properties).model_names, 10.0,
-                       "the walls to go")
-        frame = self.settled("PyBullet's window without the walls")
+
+        def gone():
+            answer = self.poll(self.world_properties)
+            if isinstance(answer, str):
+                return answer
+            return "walls" not in answer.model_names or f"models still there: {answer.model_names}"
+        self.wait_named(gone, CALL_TIMEOUT, "the walls to go (/gazebo/get_world_properties)")
+        frame = self.settled("PyBullet's window without the walls", before=with_walls)
         viewtest.save_frame(frame, "gui_no_walls")
         counts = xscreen.color_counts(self.scene(frame))
         print(f"view_gui: strong colours without the walls: {counts}", flush=True)

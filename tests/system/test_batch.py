@@ -79,7 +79,10 @@ scenarios:
         "passes": "passed", "fails": "failed", "hangs": "timeout"}, stderr
     for name in ("drive-diffbot-empty.world", "drive-diffbot-room.world", "drive-4wd-empty"):
         r = got[name]
-        assert r["sim_s"] > 8.0 and r["rtf"] > 0.5 and r["tests"] >= 1 and r["failures"] == 0, r
+        # The run's sim time came from its /clock, and its RTF is that over its wall time. How fast that is
+        # depends on the machine (0.375 on a quarter of a core for a 3x real-time run), so no bound on it.
+        assert r["sim_s"] > 8.0 and r["tests"] >= 1 and r["failures"] == 0, r
+        assert r["rtf"] > 0 and abs(r["rtf"] - r["sim_s"] / r["wall_s"]) < 0.01, r
         assert r["args"].get("seed", "1") == "1" and r["node"]
     assert got["fails"]["failures"] == 1 and "told to fail" in got["fails"]["reason"]
     assert 12.0 <= got["hangs"]["wall_s"] < 30.0
