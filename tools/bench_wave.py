@@ -231,13 +231,16 @@ def fleet_trial(count, seconds, model, rsp, laser):
 def bare_fleet(count, seconds, model):
     """``count`` of the same robots stepped by PyBullet alone (same step), wheels turning: their RTF."""
     sys.path.insert(0, os.path.join(ROOT, "src"))
+    from diffbot_sim.description import meshes
+    from diffbot_sim.description.model_files import package_path
     from diffbot_sim.description.urdf_model import parse_urdf
     from diffbot_sim.physics import World
     with open(model) as f:
         text = f.read()
+    parsed = parse_urdf(text, model)  # the meshes as the simulator prepares them (package:// resolved, cached)
+    text, _ = meshes.prepare_meshes(text, model, os.path.dirname(model), meshes.default_cache_dir(), package_path)
     world = World(STEP)
     try:
-        parsed = parse_urdf(text, model)
         for i in range(count):
             robot = world.load_robot(text, parsed, (float(i % 10), float(i // 10), 0.0))
             robot.set_velocities(robot.indices(["wheel_left_joint", "wheel_right_joint"]), [2.0, 3.0], [1.0, 1.0])

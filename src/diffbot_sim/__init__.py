@@ -1,8 +1,11 @@
-"""diffbot_sim: a PyBullet replacement for Gazebo classic + gazebo_ros for differential-drive robots.
+"""diffbot_sim: a PyBullet replacement for Gazebo classic + gazebo_ros, for mobile robots and mobile manipulators.
 
-Pure modules (no rospy): ``errors``, ``model``, ``config``, ``kinematics``, ``limits``, ``odometry``,
-``controller``, ``ddc``, ``lumping``, ``meshes``, ``keymap``, ``streams``, ``plugins.tags``. ``physics`` alone
-talks to PyBullet, ``ros_msgs`` alone builds messages, ``terminal`` alone owns the terminal; ``plugins/``
-holds one module per Gazebo plugin; ``nodes/`` hold the thin ROS shells.
+The subpackages follow the data path (docs/architecture.md): ``description`` (URDF/xacro, meshes) ->
+``world`` (SDF worlds, maps, actors) -> ``physics`` (the one owner of PyBullet) -> ``plugins`` (one module per
+Gazebo plugin or sensor type, ``plugins.ros_control`` for gazebo_ros_control) -> ``control`` and ``sensors``
+(pure maths: controllers, PIDs, trajectories, ray processing) -> ``messages`` (the one builder of ROS
+messages). ``simulator`` runs the loop and owns sim time; ``nodes/`` hold the thin ROS shells; ``teleop`` owns
+the terminal; ``gym`` holds the Gymnasium environments; ``check`` judges bodies against ground truth;
+``batch`` runs scenarios locally or on Ray. Pure subpackages import no rospy (tests/unit/test_layers.py).
 """
 __all__ = ["errors"]

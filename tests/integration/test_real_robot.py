@@ -20,13 +20,11 @@ world pose (gazebo_ros_skid_steer_drive), so in the turn it is held to the groun
 Callbacks only record; waits poll with deadlines; times are sim time. The motions and the body are judged by
 diffbot_sim.check.drive_check, shared with `robot_check`.
 """
-import math
 import sys
 import threading
 import time
 import unittest
 
-import rosgraph
 import rospy
 import rostest
 from geometry_msgs.msg import Twist
@@ -38,6 +36,7 @@ from diffbot_sim.check import drive_check
 from diffbot_sim.check.drive_check import SECONDS, SPEED, TURN, wrap
 
 SIM = "/bullet_sim"
+RAMP = 1.0  # s of sim time a command is on before its measured run starts (acceleration limits, late commands)
 
 
 def yaw_of(msg):
@@ -102,11 +101,17 @@ class RealRobotTest(unittest.TestCase):
 
     def drive(self, linear, angular, seconds, lateral=0.0):
         """Command (linear, angular) at 20 Hz of sim time for ``seconds``; returns (odom, truth) at start and
-        end, and the body samples in between."""
-        start = (self.odom.get(), self.truth.get())
-        end_time = rospy.get_time() + seconds
+        end, and the body samples in between. The measured run starts once the command has been on for RAMP s
+        of sim time: faster than real time, a busy machine delays this node's first command by wall time, which
+        would cost the run sim seconds the robot never had its command for."""
         msg = Twist()
         msg.linear.x, msg.linear.y, msg.angular.z = linear, lateral, angular
+        ramp_end = rospy.get_time() + RAMP
+        while rospy.get_time() < ramp_end:
+            self.pub.publish(msg)
+            rospy.sleep(0.05)
+        start = (self.odom.get(), self.truth.get())
+        end_time = rospy.get_time() + seconds
         while rospy.get_time() < end_time:
             self.pub.publish(msg)
             rospy.sleep(0.05)

@@ -5,6 +5,7 @@ The loop is single-threaded: subscriber callbacks (rospy's threads) only store d
 """
 import math
 import re
+import threading
 import warnings
 from dataclasses import dataclass
 from typing import Optional
@@ -61,6 +62,36 @@ def finite_twist(ctx, msg, owner):
                      "the robot keeps its last valid command")
         return None
     return values
+
+
+class PlanarCommandInbox:
+    """The latest finite body-velocity command (vx, vy, wz) [m/s, rad/s] of a planar base plugin, handed from
+    rospy's callback thread to the loop's (which takes it in ``before_step``); a new one wakes the loop."""
+
+    def __init__(self, ctx, owner):
+        self.ctx, self.owner = ctx, owner
+        self._lock = threading.Lock()
+        self._pending = None
+
+    def on_twist(self, msg):
+        values = finite_twist(self.ctx, msg, self.owner)
+        if values is None:
+            return
+        with self._lock:
+            self._pending = (values[0], values[1], values[5])
+        self.ctx.sim.wake.set()
+
+    def take(self):
+        """The command received since the last call, or None."""
+        if self._pending is None:
+            return None
+        with self._lock:
+            command, self._pending = self._pending, None
+        return command
+
+    def clear(self):
+        with self._lock:
+            self._pending = None
 
 
 @dataclass

@@ -8,7 +8,6 @@ Such a robot's wheels carry no friction (mu 0) and often a ``gazebo_ros_control`
 ``mecanum_drive_controller`` that Gazebo does not need to move it: that controller type is not simulated (one
 warning), and its odometry topic does not exist here; this plugin's own ``odometryTopic`` does, as in Gazebo.
 """
-import threading
 
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
@@ -18,7 +17,7 @@ from diffbot_sim.description.plugin_tags import plugin_filename
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import PluginNotLoaded
 from diffbot_sim.messages import common as ros_msgs
-from diffbot_sim.plugins.base import Plugin, finite_twist, join
+from diffbot_sim.plugins.base import PlanarCommandInbox, Plugin, join
 from diffbot_sim.transforms import quaternion_from_yaw, rotate
 
 #: The gain tags, in the order of the pure module's gains (x, y, yaw).
@@ -49,11 +48,10 @@ class ForceBasedMove(Plugin):
         self.base_frame = ctx.frame(ctx.clean_frame(link, path))
         self.command = (0.0, 0.0, 0.0)
         self.last_command = None  # sim time the last command arrived (None: none since load or reset)
-        self._pending = None
-        self._lock = threading.Lock()
+        self.inbox = PlanarCommandInbox(ctx, self)
         self._pushed_at = None  # sim time of the step the wrench was last added for (once per step)
         self.odometry = fbm.OdometryIntegrator(cfg.odometry_rate)
-        self.sub = ctx.subscriber(join(ns, cfg.command_topic), Twist, self._on_twist, queue_size=1)
+        self.sub = ctx.subscriber(join(ns, cfg.command_topic), Twist, self.inbox.on_twist, queue_size=1)
         self.pub = ctx.publisher(join(ns, cfg.odometry_topic), Odometry)
         self.builders = {still: ros_msgs.OdometryBuilder(self.odom_frame, self.base_frame, 0, 0, 0, *fbm.covariances(
             0.0 if still else 1.0)) for still in (True, False)}
@@ -74,14 +72,6 @@ class ForceBasedMove(Plugin):
             gains.append(used)
         return tuple(gains)
 
-    def _on_twist(self, msg):
-        values = finite_twist(self.ctx, msg, self)
-        if values is None:
-            return
-        with self._lock:
-            self._pending = (values[0], values[1], values[5])
-        self.ctx.sim.wake.set()
-
     def publishers(self):
         return [self.pub]
 
@@ -92,9 +82,9 @@ class ForceBasedMove(Plugin):
         return self.odometry.next_due()
 
     def before_step(self, now):
-        if self._pending is not None:
-            with self._lock:
-                self.command, self._pending = self._pending, None
+        command = self.inbox.take()
+        if command is not None:
+            self.command = command
             self.last_command = now
         if fbm.command_expired(now, self.last_command, self.cfg.cmd_vel_timeout):
             self.command = (0.0, 0.0, 0.0)
@@ -125,8 +115,7 @@ class ForceBasedMove(Plugin):
         self.odometry.restart(now)
 
     def reset(self, now):
-        with self._lock:
-            self._pending = None
+        self.inbox.clear()
         self.command, self.last_command, self._pushed_at = (0.0, 0.0, 0.0), None, None
         self.odometry.restart(now)
 

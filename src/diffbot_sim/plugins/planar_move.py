@@ -20,14 +20,13 @@ linear velocity and lets the joints average them (a Summit XL turns at 0.78 of i
 summit_xl_sim #35); joint rates are not zeroed either (wheels keep their spin).
 """
 import math
-import threading
 
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.messages import common as ros_msgs
-from diffbot_sim.plugins.base import Plugin, finite_twist, join
+from diffbot_sim.plugins.base import PlanarCommandInbox, Plugin, join
 from diffbot_sim.values import check_bool, check_string, tag_number
 
 #: The most a step's makeup may add to the command: the commanded speed (linear, m/s) and yaw rate (rad/s), each
@@ -57,25 +56,16 @@ class PlanarMove(Plugin):
         self.timeout = timeout if timeout > 0 else ctx.cfg.cmd_vel_timeout
         self.command = (0.0, 0.0, 0.0)
         self.stamp = None
-        self._lock = threading.Lock()
-        self._pending = None
+        self.inbox = PlanarCommandInbox(ctx, self)
         self.makeup = (0.0, 0.0, 0.0)  # added to the command: what the last step took of the velocity set
         self._set, self._set_at = None, None  # the velocity set before the last step, and when
         mass, inertia = ctx.robot.planar_inertia()
         self.gyration = math.sqrt(inertia / mass) if mass > 0 and inertia > 0 else 1.0  # m
-        self.sub = ctx.subscriber(join(ns, values["commandTopic"]), Twist, self._on_twist, queue_size=1)
+        self.sub = ctx.subscriber(join(ns, values["commandTopic"]), Twist, self.inbox.on_twist, queue_size=1)
         self.pub = ctx.publisher(join(ns, values["odometryTopic"]), Odometry)
         self.builder = ros_msgs.OdometryBuilder(self.odom_frame, self.base_frame, 1e-5, 1e-5, 1e-3)
         self.tf_builder = ros_msgs.TransformBuilder(self.odom_frame, self.base_frame)
         self.summary_values = {k: v for k, v in values.items() if v is not None}
-
-    def _on_twist(self, msg):
-        values = finite_twist(self.ctx, msg, self)
-        if values is None:
-            return
-        with self._lock:
-            self._pending = (values[0], values[1], values[5])
-        self.ctx.sim.wake.set()
 
     def publishers(self):
         return [self.pub]
@@ -84,9 +74,9 @@ class PlanarMove(Plugin):
         return self.ctx.sim.sim_time  # the body velocity is set every step, as Gazebo does
 
     def before_step(self, now):
-        if self._pending is not None:
-            with self._lock:
-                self.command, self._pending = self._pending, None
+        command = self.inbox.take()
+        if command is not None:
+            self.command = command
             self.stamp = now
         command = self.command
         if self.timeout > 0 and self.stamp is not None and now - self.stamp > self.timeout:
@@ -111,8 +101,7 @@ class PlanarMove(Plugin):
             transforms.append(self.tf_builder.build(stamp, position, orientation))
 
     def reset(self, now):
-        with self._lock:
-            self._pending = None
+        self.inbox.clear()
         self.command, self.stamp = (0.0, 0.0, 0.0), None
         self.makeup, self._set, self._set_at = (0.0, 0.0, 0.0), None, None
 

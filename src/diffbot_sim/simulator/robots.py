@@ -94,7 +94,7 @@ def _spawned_tf_prefix(model):
             namespace = tag_value(element)
             if namespace:
                 return search_tf_prefix(namespace)
-    return ""
+    return search_tf_prefix("")  # no namespace: the plugins' node handle is the root's, which finds /tf_prefix
 
 
 def search_tf_prefix(namespace):

@@ -2,7 +2,7 @@
 
 Gazebo draws the world in its own window; a headless simulator has none, so rviz must draw it. Each static
 collision shape of a :class:`diffbot_sim.world.bodies.WorldDescription` becomes one :class:`MarkerSpec` posed in
-the world frame, which :func:`diffbot_sim.nodes.world_markers.make_marker_array` turns into a
+the world frame, which :func:`diffbot_sim.messages.markers.marker_array` turns into a
 ``visualization_msgs/MarkerArray``. Collision shapes, not visuals: the reader keeps no visuals, and the
 collision geometry is what the robot and its sensors meet, so it is what a user checks against a scan.
 

@@ -42,3 +42,11 @@ def test_a_spawned_robot_searches_from_its_first_robot_namespace(params):
                      "<robotNamespace>/r2</robotNamespace>"])
     assert robots._spawned_tf_prefix(model) == "one"
 
+
+
+def test_a_spawned_robot_without_a_namespace_searches_from_the_root(params):
+    """The plugins' node handle is then the root's: roscpp's searchParam finds /tf_prefix (none set: none)."""
+    model = spawned(["", "<robotNamespace></robotNamespace>"])
+    assert robots._spawned_tf_prefix(model) == ""
+    params.update({"/tf_prefix": "everyone"})
+    assert robots._spawned_tf_prefix(model) == "everyone"

@@ -155,7 +155,6 @@ def test_first_waypoint_moves_to_time_zero_as_gazebo_11():
 
 
 def test_duplicate_trajectory_ids_play_the_last_ones_waypoints():
-    notes = []
     desc = script_actor(trajectory(((0, "0 0 0 0 0 0"), (2, "2 0 0 0 0 0")), ident=3)
                         + trajectory(((0, "0 5 0 0 0 0"), (1, "0 6 0 0 0 0")), ident=3))
     durations = [t.duration for t in desc.script.trajectories]

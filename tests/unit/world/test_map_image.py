@@ -249,7 +249,7 @@ def test_pgm_16_bit_is_scaled_to_255(tmp_path):
 
 def test_pgm_small_maxval_is_scaled(tmp_path):
     pixels = np.array([[0, 1, 2, 3]], dtype=np.uint8)  # maxval 3: 0, 85, 170, 255
-    path = write_pgm(tmp_path / "m.pgm", pixels, maxval=3)
+    write_pgm(tmp_path / "m.pgm", pixels, maxval=3)
     world = read_map(write_yaml(tmp_path / "m.yaml", image="m.pgm", resolution=1.0))
     np.testing.assert_allclose(box_bounds(mesh_of(world)[0])[:, :4], [[0.0, 2.0, 0.0, 1.0]])
 

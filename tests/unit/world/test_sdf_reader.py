@@ -794,7 +794,7 @@ def test_actors_of_the_world_and_of_includes(tmp_path):
     model_dir(models, "person", '<sdf version="1.6"><actor name="someone"><pose>9 9 0 0 0 0</pose><script>'
               '<trajectory id="0" type="walking"><waypoint><time>0</time><pose>0 0 0 0 0 0</pose></waypoint>'
               '<waypoint><time>2</time><pose>1 0 0 0 0 0</pose></waypoint></trajectory></script></actor></sdf>')
-    path = world_file(tmp_path, f"""
+    path = world_file(tmp_path, """
       <actor name="a1"><script><trajectory id="0" type="walk"><waypoint><time>0</time><pose>1 2 0 0 0 0</pose>
         </waypoint></trajectory></script></actor>
       <include><uri>model://person</uri><name>visitor</name><pose>3 4 0 0 0 1</pose></include>
