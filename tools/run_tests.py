@@ -17,6 +17,7 @@ import concurrent.futures
 import glob
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -139,13 +140,12 @@ def run_rostest(test_file, mode=None):
     env = user_env(ROS_HOME=os.path.join(base, "ros_home"))
     with open(log_path, "w") as log:
         try:
-            proc = subprocess.run(["rostest", "--results-base-dir", base, "diffbot_sim", os.path.basename(test_file)]
-                                  + args,
-                                  stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, env=env,
-                                  timeout=1200 if mode else 600)
-            code = proc.returncode
+            proc = subprocess.Popen(["rostest", "--results-base-dir", base, "diffbot_sim", os.path.basename(test_file)]
+                                    + args, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, env=env)
+            code = proc.wait(timeout=1200 if mode else 600)
         except subprocess.TimeoutExpired:
             code = "timeout"
+            stop_suite(proc, env["ROS_HOME"])
     xmls = [p for p in glob.glob(os.path.join(base, "**", "*.xml"), recursive=True)
             if not os.path.basename(p).startswith("rostest-")]
     passed, failed, skipped, names = count_junit(xmls)
@@ -158,6 +158,26 @@ def run_rostest(test_file, mode=None):
     if passed + failed + skipped == 0:
         failed, names = 1, [f"{name}: ran no test (see {log_path})"]
     return name, passed, failed, skipped, names, time.monotonic() - started
+
+
+def stop_suite(proc, ros_home):
+    """A suite past its time: rostest is asked to stop as Ctrl-C asks (it stops its nodes), then killed; then
+    every process still carrying the suite's ROS_HOME (roslaunch gives each node its own process group, so
+    no group kill reaches them all) is killed, so no leftover node loads the suites after it."""
+    proc.send_signal(signal.SIGINT)
+    try:
+        proc.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+    marker = f"ROS_HOME={ros_home}".encode()
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{pid}/environ", "rb") as environ:
+                if marker in environ.read().split(b"\0"):
+                    os.kill(int(pid), signal.SIGKILL)
+        except (OSError, ProcessLookupError):
+            pass
 
 
 def _skip_reason(name):

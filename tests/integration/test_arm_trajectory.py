@@ -52,11 +52,25 @@ class ArmTrajectory(unittest.TestCase):
         self.assertEqual(state, GoalStatus.SUCCEEDED)
 
     def test_1_goal_reached_and_the_body_agrees(self):
-        t0 = rospy.get_time()
-        state, result = self.arm.run(trajectory(JOINTS, (1.0, [0.3, 0.2, 0.4, 0.1]), (2.0, REACH)))
-        took = rospy.get_time() - t0
+        states = []
+        recorder = rospy.Subscriber("/arm_controller/state", JointTrajectoryControllerState, states.append,
+                                    queue_size=10000)
+        try:
+            state, result = self.arm.run(trajectory(JOINTS, (1.0, [0.3, 0.2, 0.4, 0.1]), (2.0, REACH)))
+            wait_for(lambda: states and close(list(states[-1].actual.positions), REACH, 0.03), 20,
+                     "the controller's state at the goal")
+        finally:
+            recorder.unregister()
         self.assertEqual((state, result.error_code), (GoalStatus.SUCCEEDED, Result.SUCCESSFUL), result.error_string)
-        self.assertLess(took, 2.0 + 1.0 + 0.5, "the goal ended long after its last point and goal_time")
+        # Timed by the controller's own stamps (sim time), not by this node's clock, which lags when it is busy:
+        # the desired trajectory leaves HOME and reaches REACH 2.0 s apart, and the joints follow within 1 s.
+        left = next(m.header.stamp.to_sec() for m in states if not close(list(m.desired.positions), HOME, 1e-4))
+        reached = next(m.header.stamp.to_sec() for m in states if close(list(m.desired.positions), REACH, 1e-4))
+        arrived = next(m.header.stamp.to_sec() for m in states if close(list(m.actual.positions), REACH, 0.03))
+        print(f"FIGURE trajectory: desired from HOME to REACH in {reached - left:.3f} s of sim time, the joints "
+              f"within 0.03 rad of it {arrived - reached:.3f} s after", flush=True)
+        self.assertAlmostEqual(reached - left, 2.0, delta=0.06, msg="the trajectory was not followed in its time")
+        self.assertLess(arrived - reached, 1.0, "the joints reached the goal long after the trajectory's end")
         wait_for(self.arm.at_rest, 20, "the arm at rest")
         self.assertTrue(close(self.arm.states.fresh() and self.arm.states.get(JOINTS), REACH, 0.03),
                         f"joints at {self.arm.states.get(JOINTS)}, goal {REACH}")
@@ -131,26 +145,33 @@ class ArmTrajectory(unittest.TestCase):
         self.assertTrue(close(after, before, 0.02), f"a refused goal moved the arm: {before} -> {after}")
 
     def test_5_the_base_still_drives(self):
-        """0.2 m/s forward until the body has gone 0.3 m (ground truth), level at its rest height."""
+        """0.2 m/s forward until the body has gone 0.3 m (ground truth), at the commanded speed once under way
+        (the body's own twist: immune to this node's lag), level at its rest height."""
         base = self.arm.world_pose(self.arm.model.root)[0]
         cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
         wait_for(lambda: cmd.get_num_connections() > 0, 10, "bullet_sim subscribed to /cmd_vel")
         twist = Twist()
         twist.linear.x = 0.2
-        start = rospy.get_time()
+        speeds = []
 
         def moved():
             cmd.publish(twist)
-            return math.dist(base[:2], self.arm.world_pose(self.arm.model.root)[0][:2]) > 0.3
+            resp = self.arm.link_state(f"{self.arm.model_name}::{self.arm.model.root}", "")
+            p, v = resp.link_state.pose.position, resp.link_state.twist.linear
+            gone = math.dist(base[:2], (p.x, p.y))
+            if gone > 0.1:
+                speeds.append(math.hypot(v.x, v.y))
+            return gone > 0.3
         try:
             wait_for(moved, 60, "the base to drive 0.3 m", poll=0.05)
         finally:
             cmd.publish(Twist())
-        took = rospy.get_time() - start
-        self.assertLess(took, 0.3 / 0.2 + 1.0, f"0.3 m at 0.2 m/s took {took:.2f} s of sim time")
+        speeds.sort()
+        speed = speeds[len(speeds) // 2]
+        print(f"FIGURE base: median speed {speed:.3f} m/s over {len(speeds)} samples once under way", flush=True)
+        self.assertAlmostEqual(speed, 0.2, delta=0.02, msg="the base does not drive at the commanded speed")
         self.assertLess(abs(self.arm.world_pose(self.arm.model.root)[0][2] - base[2]), 0.01,
                         "the base left its rest height")
-
 
 if __name__ == "__main__":
     rostest.rosrun("diffbot_sim", "arm_trajectory", ArmTrajectory, sys.argv)

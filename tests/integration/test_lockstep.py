@@ -79,7 +79,8 @@ class Lockstep(unittest.TestCase):
         self.assertTrue(np.allclose(gaps, SCAN_PERIOD, atol=1e-6),
                         f"sim time between the scans of two steps {np.round(gaps, 4).tolist()} (each should be "
                         f"one scan period, {SCAN_PERIOD} s)")
-        self.assertGreater((stamps[-1] - stamps[0]) / wall, 1.5, "lockstep ran no faster than real time")
+        # How fast is a figure here and a target in `make bench` (lockstep item): on a machine 4x slower than
+        # this one the client's own computing alone takes longer than the sim time it is given.
 
     def test_2_the_body_moves_one_period_per_step(self):
         """Ten steps of 0.2 m/s, then two of 0: the body (ground truth) moved 10 periods' worth, 0.4 m, less what

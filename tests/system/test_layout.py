@@ -62,10 +62,15 @@ def test_names_resolve_once_in_a_users_workspace(tmp_path):
     """A user clones the repository into an existing workspace's src/ and builds it there."""
     src = tmp_path / "ws" / "src"
     src.mkdir(parents=True)
-    # What a clone holds: the tracked tree, without this checkout's build products and venv.
-    shutil.copytree(ROOT, src / "diffbot_sim", symlinks=True,
-                    ignore=shutil.ignore_patterns(".git", ".venv", "build", "devel", "test-results", "__pycache__",
-                                                  "catkin_make.log"))
+    # What a clone holds: the tracked files, none of this checkout's build products, install spaces or venv.
+    tracked = subprocess.run(["git", "-C", ROOT, "ls-files", "-z"], capture_output=True, check=True).stdout
+    for name in filter(None, tracked.decode().split("\0")):
+        origin, copy = os.path.join(ROOT, name), src / "diffbot_sim" / name
+        copy.parent.mkdir(parents=True, exist_ok=True)
+        if os.path.islink(origin):
+            os.symlink(os.readlink(origin), copy)
+        elif os.path.exists(origin):  # tracked but deleted in this checkout: a clone would have it; skip
+            shutil.copy2(origin, copy)
     shutil.rmtree(src / "diffbot_sim" / "catkin_ws" / "src", ignore_errors=True)
     build = subprocess.run(["catkin_make", "-C", str(tmp_path / "ws"), f"-DPYTHON_EXECUTABLE={VENV_PY}"],
                            capture_output=True, text=True, timeout=300)

@@ -35,6 +35,7 @@ from diffbot_sim.simulator.gazebo_models import (
     WorldModelEntity,
 )
 from diffbot_sim.simulator.joint_services import JointServices
+from diffbot_sim.simulator.loop import CALL_TIMEOUT
 from diffbot_sim.transforms import compose
 
 #: Time a spawn may take on the loop (mesh conversion of a large model), before the caller gives up.
@@ -191,7 +192,7 @@ class GazeboApi:
         self.handles.append(rospy.Subscriber(f"{ns}/set_link_state", gmsg.LinkState, self._on_link_state,
                                              queue_size=10))
 
-    def _run(self, action, response, timeout=5.0):
+    def _run(self, action, response, timeout=CALL_TIMEOUT):
         """Run ``action`` on the loop; fill ``response.success``/``status_message``; never raise for a bad
         request (the caller gets success false and the reason)."""
         try:

@@ -19,6 +19,8 @@ from diffbot_sim.simulator.throttle import Throttle
 
 #: Wall seconds between two reports of the achieved real-time factor in fast mode.
 RTF_REPORT_PERIOD = 30.0
+#: Wall seconds a service request may wait for the loop (gazebo_ros's deleteModel waits 60 s for the world).
+CALL_TIMEOUT = 60.0
 
 
 class SubscriberLinks:
@@ -187,17 +189,25 @@ class Simulator:
             rospy.logwarn(text + (f" ({held} more since the last warning)" if held else ""))
 
     # -- requests from rospy's threads (services, subscribers): the loop does the work -----------------
-    def call(self, action, timeout=5.0):
+    def call(self, action, timeout=CALL_TIMEOUT):
         """Run ``action()`` on the loop's thread (the only one that touches physics and plugins) and return
         its result; an exception it raises is raised here. Works while paused.
+
+        A request the loop has not begun within ``timeout`` wall seconds is withdrawn (it never runs later:
+        the caller's failure answer stays true); one it has begun is waited for to its end.
 
         Raises:
             rospy.ServiceException: the loop did not get to it within ``timeout`` wall seconds.
         """
         done = threading.Event()
         box = {}
+        state_lock = threading.Lock()
 
         def run():
+            with state_lock:
+                if box.get("withdrawn"):
+                    return
+                box["begun"] = True
             try:
                 box["result"] = action()
             except Exception as err:  # handed back to the caller's thread, raised there
@@ -205,7 +215,12 @@ class Simulator:
             done.set()
         self.post(run)
         if not done.wait(timeout):
-            raise rospy.ServiceException(f"the simulator loop did not handle the request within {timeout:g} s")
+            with state_lock:
+                box["withdrawn"] = not box.get("begun")
+            if box["withdrawn"]:
+                raise rospy.ServiceException(f"the simulator loop did not get to the request within {timeout:g} s "
+                                             "(withdrawn: it will not run)")
+            done.wait()
         if "error" in box:
             raise box["error"]
         return box.get("result")
