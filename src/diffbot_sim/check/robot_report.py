@@ -15,6 +15,7 @@ from typing import List, Optional, Tuple
 
 from diffbot_sim import config as cfgmod
 from diffbot_sim.check import arm_report
+from diffbot_sim.check.drive_check import HOLONOMIC_PLUGINS
 from diffbot_sim.control import diff_drive_config as ddc
 from diffbot_sim.control.controller_lookup import find_controllers
 from diffbot_sim.description import meshes
@@ -88,6 +89,12 @@ class Report:
     def arm_joints(self):
         """Transmission joints that are neither drive wheels nor mimic joints."""
         return [j for j in self.joints if j.arm]
+
+    @property
+    def holonomic(self):
+        """True when the drive moves the body sideways too (planar or force-based move): it is driven sideways
+        as well (drive_check.HOLONOMIC_RUNS)."""
+        return self.drive is not None and self.drive.kind in HOLONOMIC_PLUGINS
 
     @property
     def skid(self):
@@ -189,6 +196,9 @@ def build_report(path, model_args="", controller_files=(), known=(), known_senso
             drives.append(_kobuki(values, other.path))
         elif other.filename == PLANAR_MOVE:
             drives.append(Drive(PLANAR_MOVE, other.path, note="holonomic: sets the body's velocity, no wheels"))
+        elif other.filename in HOLONOMIC_PLUGINS:
+            drives.append(Drive(other.filename, other.path,
+                                note="holonomic: pushes the body towards the commanded velocity, no wheels"))
         elif other.filename == ROS_CONTROL:
             ns = values.get("robotNamespace") or "/"
             sim_type = values.get("robotSimType") or DEFAULT_SIM_TYPE
@@ -406,10 +416,10 @@ def _format_ride(ride):
     return lines
 
 
-def format_motions(straight, turn, straight_body=None, turn_body=None):
-    """Lines for the two judged motions (:mod:`diffbot_sim.check.drive_check` results) and, when given, the body
+def format_motions(straight, turn, straight_body=None, turn_body=None, strafe=None, strafe_body=None):
+    """Lines for the judged motions (:mod:`diffbot_sim.check.drive_check` results) and, when given, the body
     during each (:class:`~diffbot_sim.check.drive_check.Ride`); ``straight``/``turn`` may be None when the motion
-    could not be run."""
+    could not be run; ``strafe`` (a holonomic base's sideways run) None when not run."""
     lines = []
     if straight is not None:
         lines.append(f"straight 0.2 m/s x 4 s: odometry {straight.odom_distance:.3f} m, ground truth "
@@ -419,6 +429,13 @@ def format_motions(straight, turn, straight_body=None, turn_body=None):
         lines.extend(f"  {text}" for text in straight.failures)
         if straight_body is not None:
             lines.extend(_format_ride(straight_body))
+    if strafe is not None:
+        lines.append(f"sideways 0.2 m/s x 4 s: odometry {strafe.odom_left:.3f} m, ground truth "
+                     f"{strafe.truth_left:.3f} m to the left (command {strafe.expected:.1f} m): "
+                     f"{'PASS' if strafe.passed else 'FAIL'}")
+        lines.extend(f"  {text}" for text in strafe.failures)
+        if strafe_body is not None:
+            lines.extend(_format_ride(strafe_body))
     if turn is not None:
         lines.append(f"turn 0.5 rad/s x 4 s: odometry {turn.odom_yaw:.3f} rad, ground truth {turn.truth_yaw:.3f} "
                      f"rad (command {turn.expected:.1f} rad), moved {turn.moved:.3f} m: "

@@ -167,7 +167,9 @@ def _settle(states, joints):
 
 
 def check_arm(report, wait):
-    """Move every arm joint of ``report`` (a robot_report.Report) and judge the body: (passed, lines).
+    """Move every arm joint of ``report`` (a robot_report.Report) and judge the body: (passed, lines, moved
+    any): nothing to move is a failure the caller excuses for a robot that drives (a holonomic base's wheels have
+    transmissions and no controller we simulate).
 
     ``wait(predicate, timeout, what)``: the caller's wait, which raises when the simulator dies.
     """
@@ -197,4 +199,4 @@ def check_arm(report, wait):
     if not results:
         lines.append("  no arm joint has a controller robot_check can move (a trajectory, gripper or position "
                      "controller in the YAMLs given)")
-    return passed, lines
+    return passed, lines, bool(results)

@@ -221,7 +221,7 @@ def _check(session, report):
         watchdog = threading.Thread(target=_watch, args=(session, time.monotonic() + DRIVE_TIMEOUT), daemon=True)
         watchdog.start()
         try:
-            passed, lines = _arm_moves.check_arm(report, lambda p, t, w: _wait(p, t, w, session))
+            passed, lines, moved = _arm_moves.check_arm(report, lambda p, t, w: _wait(p, t, w, session))
         except rospy.ROSInterruptException:
             raise SessionError(session.sim_failure() or f"the arm check took longer than {DRIVE_TIMEOUT:g} s "
                                "of wall time (sim time stopped?)") from None
@@ -230,8 +230,9 @@ def _check(session, report):
         during = [w for w in session.sim_warnings() if w not in logged and w not in report.warnings]
         for text in during[:3]:
             _say(f"  bullet_sim warned while moving the arm: {text}")
-        verdicts.append((passed, "its arm joints move as commanded, the body where joint_states + the URDF "
-                                 "put it" if passed else "the arm does not move as commanded (ground truth)"))
+        if moved or not verdicts:  # joints with no controller to move them: a driving robot is judged by its drive
+            verdicts.append((passed, "its arm joints move as commanded, the body where joint_states + the URDF "
+                                     "put it" if passed else "the arm does not move as commanded (ground truth)"))
     failed = [text for ok, text in verdicts if not ok]
     if failed:
         _say(f"result: FAIL: {failed[0]}")
@@ -282,6 +283,15 @@ def _drive(session, report):
         straight_body = drive_check.ride(truth.take_span(), rest.height, "driving straight")
         _command(pub, 0.0, 0.0, PAUSE)
         straight = drive_check.straight(start[0], end[0], start[1], end[1])
+        strafe = strafe_body = None
+        if report.holonomic:  # a planar or force-based base also moves sideways (drive_check.STRAFE_RUN)
+            start = (odom.get(), truth.get())
+            truth.start_span()
+            _command(pub, 0.0, 0.0, drive_check.SECONDS, lateral=drive_check.SPEED)
+            end = (odom.get(), truth.get())
+            strafe_body = drive_check.ride(truth.take_span(), rest.height, "driving sideways")
+            _command(pub, 0.0, 0.0, PAUSE)
+            strafe = drive_check.strafe(start[0], end[0], start[1], end[1])
         start = (odom.get(), truth.get())
         truth.start_span()
         _command(pub, 0.0, drive_check.TURN, drive_check.SECONDS)
@@ -302,7 +312,7 @@ def _drive(session, report):
             sub.unregister()
     for line in robot_report.format_rest(rest):
         _say(line)
-    for line in robot_report.format_motions(straight, turn, straight_body, turn_body):
+    for line in robot_report.format_motions(straight, turn, straight_body, turn_body, strafe, strafe_body):
         _say(line)
     during = [w for w in session.sim_warnings() if w not in logged and w not in report.warnings]
     for text in during[:3]:
@@ -311,18 +321,20 @@ def _drive(session, report):
         _say(f"  ... and {len(during) - 3} more")
     if not rest.passed:
         return False, "the robot does not rest upright on the ground before driving (ground truth)"
-    if straight.passed and turn.passed and straight_body.passed and turn_body.passed:
+    sideways_ok = strafe is None or (strafe.passed and strafe_body.passed)
+    if straight.passed and turn.passed and straight_body.passed and turn_body.passed and sideways_ok:
         return True, "the robot drives"
     return False, "the robot does not drive as commanded"
 
 
-def _command(pub, linear, angular, seconds):
-    """Publish (linear, angular) at COMMAND_RATE of sim time for ``seconds`` of sim time."""
+def _command(pub, linear, angular, seconds, lateral=0.0):
+    """Publish (linear, angular; ``lateral`` to the left, m/s) at COMMAND_RATE of sim time for ``seconds`` of
+    sim time."""
     import rospy
     from geometry_msgs.msg import Twist
 
     msg = Twist()
-    msg.linear.x, msg.angular.z = linear, angular
+    msg.linear.x, msg.linear.y, msg.angular.z = linear, lateral, angular
     end = rospy.get_time() + seconds
     while rospy.get_time() < end:
         pub.publish(msg)
