@@ -19,6 +19,7 @@ and their fixtures: arm_traits.test.
 import math
 import os
 import sys
+import threading
 import unittest
 
 import actionlib
@@ -46,6 +47,7 @@ CONTROLLERS = {"grip_effort": ["gripper_effort_controller"], "grip_position": ["
                "grasp": ["lift_controller", "fingers_controller"]}
 GRIPPERS = {"grip_effort": "gripper_effort_controller", "grip_position": "gripper_position_controller"}
 BOX = (0.03, 0.04, 0.04)  # m: the box the vises close on (x, along the jaw travel, height)
+HELD, LET_GO = 0.05, 0.3  # m a pushed box travels at most when gripped, at least when the grip lets it slide
 
 
 def settle(read, tolerance, timeout=30.0, interval=0.3):
@@ -112,6 +114,16 @@ class ArmTraits(unittest.TestCase):
         spawn_box(name, BOX, 0.1, (x, y - 0.05 + BOX[1] / 2 + 0.001, 0.05 + BOX[2] / 2 + 0.001))
         sim_sleep(0.3)
 
+    def assert_clamped(self, ns, name, when):
+        """The box, in the vise's base frame, lies between the jaws' faces (its 3 cm along x within the jaws'
+        4 cm: |x| <= 5 mm), against the fixed jaw (y = -0.05 + half its width, within 2.5 mm) and on the base
+        top (z = 0.05 + half its height, within 3 mm: not lifted out)."""
+        (x, y, z), _ = self.truth.link(f"{name}::link", f"{ns}::base_link")
+        off = (x, y - (-0.05 + BOX[1] / 2), z - (0.05 + BOX[2] / 2))
+        self.assertTrue(abs(off[0]) <= 0.005 and abs(off[1]) <= 0.0025 and abs(off[2]) <= 0.003,
+                        f"/{ns}: the box is not clamped in the vise {when}: off by {[round(v, 4) for v in off]} m "
+                        "(x, y, z in the vise's frame; limits 5, 2.5, 3 mm)")
+
     def push(self, name, force, seconds):
         """A push along +x on the box's centre (apply_body_wrench); the box's travel over the push and 0.5 s."""
         before = self.truth.object(name)[0]
@@ -141,28 +153,37 @@ class ArmTraits(unittest.TestCase):
             self.grip(ns, 0.06, 15.0)
             name = f"{ns}_box"
             self.box_at(ns, name)
-            start = self.truth.object(name)[0]
-            status, result = self.grip(ns, 0.0, 15.0)
-            self.assertEqual(status, GoalStatus.ABORTED, f"/{ns}: closing on a box should stall: {result}")
-            self.assertTrue(result.stalled and not result.reached_goal, f"/{ns}: {result}")
-            self.assertAlmostEqual(result.position, BOX[1], delta=0.003, msg=f"/{ns}: not stopped on the box")
-            self.assertAlmostEqual(self.jaw(ns), BOX[1], delta=0.003, msg=f"/{ns}: the jaw is not on the box")
-            held = self.truth.object(name)[0]
-            self.assertLess(math.dist(start, held), 0.004, f"/{ns}: the box was shoved away")
-            sim_sleep(1.0)
-            self.assertLess(math.dist(held, self.truth.object(name)[0]), 0.001, f"/{ns}: the held box moves")
-            self.assertAlmostEqual(self.jaw(ns), BOX[1], delta=0.003, msg=f"/{ns}: the jaw let go after the stall")
-            pushes[ns] = {15.0: self.push(name, 10.0, 0.1)}
-            # the same push on a 2 N grip: the effort jaw squeezes with 2 N (friction 4 N < 10 N), the position
-            # jaw with the URDF's 20 N whatever the goal says
-            status, result = self.grip(ns, 0.0, 2.0)
-            self.assertTrue(result.stalled, f"/{ns}: {result}")
-            pushes[ns][2.0] = self.push(name, 10.0, 0.1)
-            self.delete(name)
-        self.assertLess(pushes["grip_effort"][15.0], 0.003, f"a 15 N grip let a 10 N push move the box: {pushes}")
-        self.assertGreater(pushes["grip_effort"][2.0], 0.01, f"a 2 N grip held against a 10 N push: {pushes}")
-        self.assertLess(pushes["grip_position"][15.0], 0.003, f"the position jaw let the box go: {pushes}")
-        self.assertLess(pushes["grip_position"][2.0], 0.003,
+            try:
+                start = self.truth.object(name)[0]
+                status, result = self.grip(ns, 0.0, 15.0)
+                self.assertEqual(status, GoalStatus.ABORTED, f"/{ns}: closing on a box should stall: {result}")
+                self.assertTrue(result.stalled and not result.reached_goal, f"/{ns}: {result}")
+                self.assertAlmostEqual(result.position, BOX[1], delta=0.003, msg=f"/{ns}: not stopped on the box")
+                self.assertAlmostEqual(self.jaw(ns), BOX[1], delta=0.003, msg=f"/{ns}: the jaw is not on the box")
+                held = self.truth.object(name)[0]
+                self.assertLess(math.dist(start, held), 0.01, f"/{ns}: the box was shoved away: {start} -> {held}")
+                self.assert_clamped(ns, name, "on the stall")
+                sim_sleep(1.0)
+                later = self.truth.object(name)[0]
+                # Bullet lets a box squeezed at 20 N creep by up to ~1 mm/s (docs/migrating.md, Known limits)
+                self.assertLess(math.dist(held, later), 0.003, f"/{ns}: the held box moves: {held} -> {later}, "
+                                f"the jaw at {self.jaw(ns):.4f} m")
+                self.assert_clamped(ns, name, "1 s after the stall")
+                self.assertAlmostEqual(self.jaw(ns), BOX[1], delta=0.003, msg=f"/{ns}: the jaw let go after the stall")
+                pushes[ns] = {15.0: self.push(name, 10.0, 0.1)}
+                # the same push on a 2 N grip: the effort jaw squeezes with 2 N (friction 4 N < 10 N), the position
+                # jaw with the URDF's 20 N whatever the goal says
+                status, result = self.grip(ns, 0.0, 2.0)
+                self.assertTrue(result.stalled, f"/{ns}: {result}")
+                pushes[ns][2.0] = self.push(name, 10.0, 0.1)
+            finally:  # a failure here leaves no box in the vise for the next test
+                self.delete(name)
+        # Held, the box stays in the vise (a squeezed box in Bullet may rock and slip a few cm, docs/migrating.md
+        # Known limits); let go, the 10 N push (60 m/s^2 past the friction of a 2 N grip) slides it metres.
+        self.assertLess(pushes["grip_effort"][15.0], HELD, f"a 15 N grip let a 10 N push move the box: {pushes}")
+        self.assertGreater(pushes["grip_effort"][2.0], LET_GO, f"a 2 N grip held against a 10 N push: {pushes}")
+        self.assertLess(pushes["grip_position"][15.0], HELD, f"the position jaw let the box go: {pushes}")
+        self.assertLess(pushes["grip_position"][2.0], HELD,
                         f"the position jaw squeezed with the goal's max_effort, not the URDF's effort: {pushes}")
 
     def test_gripper_3_max_effort_zero_does_not_move_the_effort_jaw(self):
@@ -258,36 +279,47 @@ class ArmTraits(unittest.TestCase):
                                    msg=f"follower_joint at {follower:.4f} for master {actual:.4f}")
 
     # -- joint limits ------------------------------------------------------------------------------------
-    def rates(self, ns, joint, low, high, timeout=30.0):
-        """The joint's rate [rad/s] (its link's angular velocity about z from ground truth; the base rests level)
-        at every instant sampled while its position is within (low, high), until it has left that window. The
-        physics runs in short unpause-pause round trips and is read while paused (fast mode runs too many
-        steps between two unpaused reads)."""
-        link = f"{ns}::{self.truth.model(ns).joints[joint].child}"
-        pause, unpause = (rospy.ServiceProxy(f"/gazebo/{what}_physics", Empty) for what in ("pause", "unpause"))
-        seen = []
+    def rates(self, ns, joint, low, high, prepare, go, timeout=60.0):
+        """The joint's rate [rad/s] between consecutive ``/<ns>/joint_states`` samples (joint_state_controller
+        at 50 Hz of sim time: the simulated joint's position, finite-differenced over the messages' sim stamps)
+        while it is within (low, high), once ``prepare()`` has brought it to one side of that window and ``go()``
+        commanded it across. Every message is
+        kept (a fast-mode run delivers them all, late or not), so no reading depends on the test's wall time."""
+        samples, lock = [], threading.Lock()
 
-        def through():
-            inside = low < self.truth.joint(ns, joint) < high
-            if inside:
-                seen.append(self.truth.link_state(link, "").link_state.twist.angular.z)
-            elif seen:
-                return True
-            unpause()
-            pause()
-            return False
-        pause()
+        def keep(msg):
+            if joint in msg.name:
+                with lock:
+                    samples.append((msg.header.stamp.to_sec(), msg.position[msg.name.index(joint)]))
+        sub = rospy.Subscriber(f"/{ns}/joint_states", JointState, keep, queue_size=10000)
         try:
-            wait_for(through, timeout, f"{joint} sampled inside ({low}, {high}) and past it")
+            wait_for(lambda: samples, 20, f"/{ns}/joint_states")
+            prepare()
+            far = (lambda q: q >= high) if self.truth.joint(ns, joint) <= low else (lambda q: q <= low)
+            with lock:
+                del samples[:]
+            go()
+
+            def crossed():
+                with lock:
+                    return any(far(q) for _, q in samples)
+            wait_for(crossed, timeout, f"{joint} across ({low}, {high})")
         finally:
-            unpause()
-        return seen
+            sub.unregister()
+        with lock:
+            pairs = [(a, b) for a, b in zip(samples, samples[1:])
+                     if low < a[1] < high and low < b[1] < high and b[0] > a[0]]
+        self.assertGreaterEqual(len(pairs), 5, f"{joint}: {len(pairs)} samples inside ({low}, {high})")
+        return [(b[1] - a[1]) / (b[0] - a[0]) for a, b in pairs]
 
     def test_limits_1_position_stops_at_the_limit_rate_limited_by_the_velocity_limit(self):
         ns = "limits"
         pub = self.publisher(f"/{ns}/pos_controller/command", Float64)
-        pub.publish(Float64(1.5))
-        rates = self.rates(ns, "pos_joint", 0.05, 0.95)
+
+        def prepare():
+            pub.publish(Float64(0.0))
+            wait_for(lambda: self.truth.joint(ns, "pos_joint") < 0.02, 30, "pos_joint at 0")
+        rates = self.rates(ns, "pos_joint", 0.05, 0.95, prepare, lambda: pub.publish(Float64(1.5)))
         median = sorted(rates)[len(rates) // 2]
         self.assertAlmostEqual(median, 0.4, delta=0.03, msg="pos_joint is not rate-limited at joint_limits/pos_joint/"
                                f"max_velocity 0.4 rad/s (URDF 0.5): {rates} rad/s")
@@ -297,12 +329,13 @@ class ArmTraits(unittest.TestCase):
     def test_limits_2_velocity_clamped(self):
         ns = "limits"
         pub = self.publisher(f"/{ns}/vel_controller/command", Float64)
-        pub.publish(Float64(3.0))
-        wait_for(lambda: self.truth.joint(ns, "vel_joint") > 0.98, 30, "vel_joint at its upper limit")
-        pub.publish(Float64(-3.0))
+
+        def prepare():
+            pub.publish(Float64(3.0))
+            wait_for(lambda: self.truth.joint(ns, "vel_joint") > 0.98, 30, "vel_joint at its upper limit")
         try:
             # 2 rad/s^2 (joint_limits/vel_joint/max_acceleration): full speed after 0.5 s and 0.25 rad
-            rates = self.rates(ns, "vel_joint", -0.95, 0.7)
+            rates = self.rates(ns, "vel_joint", -0.95, 0.7, prepare, lambda: pub.publish(Float64(-3.0)))
         finally:
             pub.publish(Float64(0.0))
         median = sorted(rates)[len(rates) // 2]
