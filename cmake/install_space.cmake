@@ -73,6 +73,19 @@ install(FILES ${_diffbot_batch_tests} DESTINATION ${_diffbot_rostest_dir})
 install(PROGRAMS ${_diffbot_test_nodes} DESTINATION ${_diffbot_rostest_dir})
 install(FILES ${_diffbot_test_helpers} DESTINATION ${_diffbot_rostest_dir})
 diffbot_sim_venv_first_line(${_diffbot_rostest_dir} ${_diffbot_test_nodes})
+# Fixture files the batch scenarios load from tests/data ($(find diffbot_sim)/tests/data/<kind>/<file> in a
+# tests/rostest/*.test): installed where those lines look.
+foreach(_test ${_diffbot_batch_tests})
+  file(STRINGS ${_test} _lines REGEX "\\$\\(find diffbot_sim\\)/tests/data/")
+  foreach(_line ${_lines})
+    string(REGEX MATCHALL "\\$\\(find diffbot_sim\\)/tests/data/[A-Za-z0-9_./-]+" _uses "${_line}")
+    foreach(_use ${_uses})
+      string(REPLACE "$(find diffbot_sim)/" "" _rel "${_use}")
+      get_filename_component(_rel_dir ${_rel} DIRECTORY)
+      install(FILES ${CMAKE_CURRENT_SOURCE_DIR}/${_rel} DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION}/${_rel_dir})
+    endforeach()
+  endforeach()
+endforeach()
 
 # catkin writes the install space's _setup_util.py (run by every `source PREFIX/setup.bash`) with the build's
 # Python on its first line. In catkin_ws (tools/setup.sh) that is the checkout's .venv, which a plain

@@ -1,7 +1,7 @@
 """Reproducible in lockstep (issue 27, item 3): the same scenario with the same seed gives the same trajectory, run
 after run, alone or among 8 parallel batch runs.
 
-The scenario is tests/integration/loop_repro.test (a Gazebo-style step-and-wait client driving the laser robot with
+The scenario is tests/rostest/loop_repro.test (a Gazebo-style step-and-wait client driving the laser robot with
 actions from numpy's default_rng(seed), reset_simulation between its two episodes, random wall time of work between
 steps; the simulator in fast mode with ~wait_for_nodes). Here it runs as a user runs it: `rostest` twice, one after
 the other, then once with another seed; then examples/batch/repro.yaml (8 runs of the same seed) through
