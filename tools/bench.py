@@ -187,7 +187,8 @@ def probe_rtf(options):
     from geometry_msgs.msg import Twist
     from nav_msgs.msg import Odometry
     from rosgraph_msgs.msg import Clock
-    rospy.init_node("bench_rtf", disable_signals=True)
+    if not rospy.core.is_initialized():  # a probe that set up its scenario first (bench_wave) already is
+        rospy.init_node("bench_rtf", disable_signals=True)
     clock, odom = [], []
     rospy.Subscriber("/clock", Clock, lambda m: clock.append((time.monotonic(), m.clock.to_sec())),
                      queue_size=1000)

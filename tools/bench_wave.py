@@ -33,6 +33,11 @@ ARM_YAML = os.path.join(ROOT, "tests", "data", "robots", "mobile_arm6.yaml")
 ARM_JOINTS = [f"joint_{k}" for k in range(1, 7)]
 LASER_ROBOT = os.path.join(ROOT, "tests", "data", "robots", "laser_robot.urdf")
 TB3LIKE = os.path.join(ROOT, "tests", "data", "multi_way", "tb3like_description", "urdf", "tb3like.urdf.xacro")
+# the fleet's robot is a Gazebo user's package (package:// meshes, $(find tb3like_description)): findable by
+# xacro here and by every launch started from here
+os.environ["ROS_PACKAGE_PATH"] = os.pathsep.join(
+    [p for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
+    + [os.path.join(ROOT, "tests", "data", "multi_way")])
 
 
 # ---------------------------------------------------------------------------------------------------- arm
@@ -69,9 +74,10 @@ def probe_arm_latency(options):
     from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
     rospy.init_node("bench_arm_latency", disable_signals=True)
     states = []
-    rospy.Subscriber("/gazebo/link_states", LinkStates, lambda m: states.append((rospy.get_time(), m)),
-                     queue_size=2000)
     clock = []
+    # link_states carry no stamp: each is stamped with the newest /clock (100 Hz: a 10 ms resolution)
+    rospy.Subscriber("/gazebo/link_states", LinkStates, lambda m: states.append((clock[-1] if clock else 0.0, m)),
+                     queue_size=2000)
     rospy.Subscriber("/clock", Clock, lambda m: clock.append(m.clock.to_sec()), queue_size=10)
     pub = rospy.Publisher("/arm_controller/command", JointTrajectory, queue_size=1)
     bench._wait(lambda: pub.get_num_connections() > 0 and clock and states, 60, "the arm and link_states")

@@ -421,27 +421,21 @@ def format_motions(straight, turn, straight_body=None, turn_body=None, strafe=No
     during each (:class:`~diffbot_sim.check.drive_check.Ride`); ``straight``/``turn`` may be None when the motion
     could not be run; ``strafe`` (a holonomic base's sideways run) None when not run."""
     lines = []
+
+    def judged(headline, result, body):
+        lines.append(f"{headline}: {'PASS' if result.passed else 'FAIL'}")
+        lines.extend(f"  {text}" for text in result.failures)
+        if body is not None:
+            lines.extend(_format_ride(body))
     if straight is not None:
-        lines.append(f"straight 0.2 m/s x 4 s: odometry {straight.odom_distance:.3f} m, ground truth "
-                     f"{straight.truth_distance:.3f} m (command {straight.expected:.1f} m); heading change "
-                     f"{straight.odom_heading:.3f} / {straight.truth_heading:.3f} rad: "
-                     f"{'PASS' if straight.passed else 'FAIL'}")
-        lines.extend(f"  {text}" for text in straight.failures)
-        if straight_body is not None:
-            lines.extend(_format_ride(straight_body))
+        judged(f"straight 0.2 m/s x 4 s: odometry {straight.odom_distance:.3f} m, ground truth "
+               f"{straight.truth_distance:.3f} m (command {straight.expected:.1f} m); heading change "
+               f"{straight.odom_heading:.3f} / {straight.truth_heading:.3f} rad", straight, straight_body)
     if strafe is not None:
-        lines.append(f"sideways 0.2 m/s x 4 s: odometry {strafe.odom_left:.3f} m, ground truth "
-                     f"{strafe.truth_left:.3f} m to the left (command {strafe.expected:.1f} m): "
-                     f"{'PASS' if strafe.passed else 'FAIL'}")
-        lines.extend(f"  {text}" for text in strafe.failures)
-        if strafe_body is not None:
-            lines.extend(_format_ride(strafe_body))
+        judged(f"sideways 0.2 m/s x 4 s: odometry {strafe.odom_left:.3f} m, ground truth "
+               f"{strafe.truth_left:.3f} m to the left (command {strafe.expected:.1f} m)", strafe, strafe_body)
     if turn is not None:
-        lines.append(f"turn 0.5 rad/s x 4 s: odometry {turn.odom_yaw:.3f} rad, ground truth {turn.truth_yaw:.3f} "
-                     f"rad (command {turn.expected:.1f} rad), moved {turn.moved:.3f} m: "
-                     f"{'PASS' if turn.passed else 'FAIL'}")
-        lines.extend(f"  {text}" for text in turn.failures)
-        if turn_body is not None:
-            lines.extend(_format_ride(turn_body))
+        judged(f"turn 0.5 rad/s x 4 s: odometry {turn.odom_yaw:.3f} rad, ground truth {turn.truth_yaw:.3f} "
+               f"rad (command {turn.expected:.1f} rad), moved {turn.moved:.3f} m", turn, turn_body)
     return lines
 
