@@ -13,7 +13,7 @@ from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from diffbot_sim.check.arm_check import pose_errors
 from diffbot_sim.description.urdf_model import parse_urdf
-from simtest import wait_for
+from simtest import action_done, wait_for
 
 
 class JointStates:
@@ -79,7 +79,7 @@ class Arm:
         time, which fast mode spends in a fraction of a second while a busy machine delays the result):
         (goal status, result)."""
         self.client.send_goal(self.goal(msg, **kwargs))
-        wait_for(lambda: self.client.simple_state == actionlib.SimpleGoalState.DONE, timeout, "the goal's result")
+        wait_for(lambda: action_done(self.client), timeout, "the goal's result")
         return self.client.get_state(), self.client.get_result()
 
     def world_pose(self, link):

@@ -30,6 +30,16 @@ def finite_odom(msg):
     return all(math.isfinite(x) for x in (p.x, p.y, p.z, q.x, q.y, q.z, q.w, v.x, v.y, v.z, w.x, w.y, w.z))
 
 
+def action_done(client):
+    """Whether a SimpleActionClient's current goal has ended (its result is in). Judged on the goal handle:
+    actionlib's SimpleActionClient drops the transitions of a goal that ends before ``send_goal`` has stored
+    its handle ("Got a transition callback on a goal handle that we're not tracking"), leaving its own state
+    PENDING for ever; a goal already met ends that fast in fast mode."""
+    from actionlib import CommState
+    handle = client.gh
+    return handle is not None and handle.get_comm_state() == CommState.DONE
+
+
 def wait_for(predicate, timeout, what, poll=0.02):
     """Poll ``predicate`` until it returns something true (returned) or ``timeout`` wall seconds pass
     (AssertionError naming ``what``)."""

@@ -36,7 +36,7 @@ from std_msgs.msg import Float64, Float64MultiArray
 from std_srvs.srv import Empty
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from simtest import Latest, wait_for  # noqa: E402
+from simtest import Latest, action_done, wait_for  # noqa: E402
 from traittest import Manager, Truth, sim_sleep, spawn_box  # noqa: E402
 
 from diffbot_sim.transforms import compose  # noqa: E402
@@ -105,11 +105,10 @@ class ArmTraits(unittest.TestCase):
         goal.command.position, goal.command.max_effort = position, max_effort
         client.send_goal(goal)
         deadline = time.monotonic() + timeout  # wall s: actionlib's own wait counts sim time (fast mode)
-        while client.simple_state != actionlib.SimpleGoalState.DONE and time.monotonic() < deadline:
+        while not action_done(client) and time.monotonic() < deadline:
             time.sleep(0.02)
-        self.assertEqual(client.simple_state, actionlib.SimpleGoalState.DONE,
-                         f"/{ns}: no result of the goal to {position} m within {timeout} s (status "
-                         f"{client.get_state()}, the jaw at {self.jaw(ns):.4f} m)")
+        self.assertTrue(action_done(client), f"/{ns}: no result of the goal to {position} m within {timeout} s "
+                        f"(status {client.get_state()}, the jaw at {self.jaw(ns):.4f} m)")
         return client.get_state(), client.get_result()
 
     def jaw(self, ns):

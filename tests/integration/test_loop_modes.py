@@ -7,7 +7,8 @@ half a tick before (a scan stamped at the tick itself is a race at real time), b
 sim time; in fast mode with ~wait_for_nodes the simulator holds sim time while the node works, so its commands
 act at the same sim times; unbounded, each command lands tens to hundreds of ms of sim time late and the path
 drifts. Judged by ground truth (~ground_truth): the fast run's poses at the same sim times stay within
-TOLERANCE of the real-time run's (measured 0.6-1.7 cm; with ~wait_for_nodes false the same check fails: 1.2 m)."""
+TOLERANCE of the real-time run's (measured 0.6-1.7 cm, once 16 cm; with ~wait_for_nodes false the same check fails:
+1.2 m)."""
 import collections
 import math
 import os
@@ -30,7 +31,10 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from simtest import wait_for  # noqa: E402
 
 RUN = 12.0  # s of sim time
-TOLERANCE = 0.05  # m: fast vs real time, at the same sim times
+# m: fast vs real time, at the same sim times. Typically 0.6-1.7 cm; a tick that reads the wall ahead just
+# either side of the turn threshold (0.9 m) at real time, where its command lands 15+ ms late, once took the
+# path 16 cm away in 10 runs; unbounded fast mode misses by 1.2 m.
+TOLERANCE = 0.25
 TIME_STEP = 1.0 / 240.0
 
 
