@@ -302,6 +302,22 @@ def session_pids(sid):
 
 # -- the time a process waited for a CPU (wall-clock bounds of the reliability suites) ----------------------
 
+#: The goal marker a Gazebo learning environment respawns every episode (TurtleBot3's machine-learning chapter):
+#: a static model with one visual and no collision.
+GOAL_MARKER_SDF = ('<?xml version="1.0"?><sdf version="1.6"><model name="goal"><static>true</static>'
+                   '<link name="goal"><visual name="v"><geometry><cylinder><radius>0.1</radius><length>0.05'
+                   '</length></cylinder></geometry></visual></link></model></sdf>')
+
+
+def agent_work(seconds):
+    """A learning agent's work between two steps: CPU, not sleep (a network's forward pass)."""
+    import numpy as np
+    end = time.monotonic() + seconds
+    a = np.ones((64, 64))
+    while time.monotonic() < end:
+        a = np.tanh(a @ a.T * 1e-3)
+
+
 def run_delay(pid):
     """Seconds the main thread of ``pid`` has spent runnable but not running: waiting for a CPU while other
     processes had the cores or its cgroup's CPU quota was spent (the kernel's ``/proc/<pid>/schedstat``; a

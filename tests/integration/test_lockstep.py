@@ -26,21 +26,10 @@ from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from simtest import Latest, wait_for  # noqa: E402
+from simtest import GOAL_MARKER_SDF, Latest, agent_work, wait_for  # noqa: E402
 
 SCAN_PERIOD = 0.2  # s: laser_robot.urdf's 5 Hz laser
 STEPS = 30
-MARKER = ('<?xml version="1.0"?><sdf version="1.6"><model name="goal"><static>true</static><link name="goal">'
-          '<visual name="v"><geometry><cylinder><radius>0.1</radius><length>0.05</length></cylinder></geometry>'
-          '</visual></link></model></sdf>')
-
-
-def compute(seconds):
-    """The agent's work between steps: CPU, not sleep (a network's forward pass)."""
-    end = time.monotonic() + seconds
-    a = np.ones((64, 64))
-    while time.monotonic() < end:
-        a = np.tanh(a @ a.T * 1e-3)
 
 
 class Lockstep(unittest.TestCase):
@@ -62,7 +51,7 @@ class Lockstep(unittest.TestCase):
         twist.linear.x, twist.angular.z = linear, angular
         self.cmd.publish(twist)
         scan = rospy.wait_for_message("/scan", LaserScan, timeout=30)
-        compute(work)
+        agent_work(work)
         return scan.header.stamp.to_sec()
 
     def test_1_each_action_is_held_one_scan_period(self):
@@ -101,7 +90,7 @@ class Lockstep(unittest.TestCase):
     def test_3_goal_marker_spawned_and_deleted_while_held(self):
         """respawnGoal's pattern: spawn, busy-wait until model_states lists it, delete, busy-wait until gone."""
         for _ in range(3):
-            self.assertTrue(self.spawn("goal", MARKER, "robotos_name_space", Pose(), "world").success)
+            self.assertTrue(self.spawn("goal", GOAL_MARKER_SDF, "robotos_name_space", Pose(), "world").success)
             deadline = time.monotonic() + 20
             while "goal" not in (self.states.get().name if self.states.get() else []):  # busy, as the original
                 self.assertLess(time.monotonic(), deadline, "the goal never appeared in model_states")

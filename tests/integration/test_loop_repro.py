@@ -40,24 +40,13 @@ from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from simtest import figure, wait_for, yaw_of  # noqa: E402
+from simtest import GOAL_MARKER_SDF, agent_work, figure, wait_for, yaw_of  # noqa: E402
 
 SCAN_PERIOD_NS = 200_000_000  # laser_robot.urdf's 5 Hz laser
 MIN_PATH = 0.3  # m the body must travel over the run for the comparison to mean something
 MIN_TURN = 0.5  # rad of heading change, summed
 MAX_WORK = 0.04  # s: the longest CPU work between two steps
 MAX_IDLE = 0.02  # s: the longest idle pause (I/O) between two steps
-MARKER = ('<?xml version="1.0"?><sdf version="1.6"><model name="goal"><static>true</static><link name="goal">'
-          '<visual name="v"><geometry><cylinder><radius>0.1</radius><length>0.05</length></cylinder></geometry>'
-          '</visual></link></model></sdf>')
-
-
-def compute(seconds):
-    """The agent's work between steps: CPU, not sleep (a network's forward pass)."""
-    end = time.monotonic() + seconds
-    a = np.ones((64, 64))
-    while time.monotonic() < end:
-        a = np.tanh(a @ a.T * 1e-3)
 
 
 class TruthLog:
@@ -203,7 +192,7 @@ class Repro(unittest.TestCase):
                 self.assertLess(time.monotonic(), deadline, "the goal never left model_states")
         x, y = self.rng.uniform(-1.0, 1.5), self.rng.uniform(-1.2, 1.8)
         pose = Pose(Point(float(x), float(y), 0.0), Quaternion(0.0, 0.0, 0.0, 1.0))
-        self.assertTrue(self.spawn("goal", MARKER, "", pose, "world").success)
+        self.assertTrue(self.spawn("goal", GOAL_MARKER_SDF, "", pose, "world").success)
         deadline = time.monotonic() + 20
         while not self._listed("goal"):
             self.assertLess(time.monotonic(), deadline, "the goal never appeared in model_states")
@@ -215,7 +204,7 @@ class Repro(unittest.TestCase):
         self.cmd.publish(twist)
         scan = rospy.wait_for_message("/scan", LaserScan, timeout=30)
         row = self.record(previous["episode"], previous["step"] + 1, scan, linear, angular)
-        compute(self.jitter.uniform(0.0, MAX_WORK))
+        agent_work(self.jitter.uniform(0.0, MAX_WORK))
         if self.jitter.random() < 0.3:
             time.sleep(self.jitter.uniform(0.0, MAX_IDLE))  # idle, not subscribed: still held
         # Held for us, sim time is still the scan's when we act: ground truth stamped later is proof it was not

@@ -33,7 +33,7 @@ from geometry_msgs.msg import Point, Pose, Quaternion
 from std_srvs.srv import Empty
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from simtest import SIM, figure, node_pid, rss_kib, run_delay  # noqa: E402
+from simtest import GOAL_MARKER_SDF, SIM, figure, node_pid, rss_kib, run_delay  # noqa: E402
 
 CALLER = "/test_slow_resets"
 CHECKPOINTS = 10
@@ -44,9 +44,6 @@ BOX_EVERY = 100  # iterations between two spawns of the box with a collision
 MAX_RSS_GROWTH_KIB = 20 * 1024
 MAX_SLOWDOWN = 1.5
 SETTLE_TIMEOUT = 10.0  # wall s for fds and threads to hold still after the last call
-GOAL = ('<?xml version="1.0"?><sdf version="1.6"><model name="goal"><static>true</static><link name="goal">'
-        '<visual name="v"><geometry><cylinder><radius>0.1</radius><length>0.05</length></cylinder></geometry>'
-        '</visual></link></model></sdf>')
 BOX = ('<?xml version="1.0"?><sdf version="1.6"><model name="box"><link name="link"><inertial><mass>0.5</mass>'
        '</inertial><collision name="c"><geometry><box><size>0.2 0.2 0.2</size></box></geometry></collision>'
        '<visual name="v"><geometry><box><size>0.2 0.2 0.2</size></box></geometry></visual></link></model></sdf>')
@@ -146,7 +143,7 @@ class Resets(unittest.TestCase):
             if response is not None and hasattr(response, "success") and not response.success:
                 failures.append(f"iteration {k}: {name}{args[:1]}: {response.status_message}")
         timed("reset_simulation")
-        timed("spawn_sdf_model", "goal", GOAL, "", pose(1.0, 0.5, 0.0), "world")
+        timed("spawn_sdf_model", "goal", GOAL_MARKER_SDF, "", pose(1.0, 0.5, 0.0), "world")
         timed("delete_model", "goal")
         if k % BOX_EVERY == BOX_EVERY - 1:
             for name, args in (("spawn_sdf_model", ("box", BOX, "", pose(2.0, -1.0, 0.2), "world")),
