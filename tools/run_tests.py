@@ -298,7 +298,7 @@ def main():
     parser.add_argument("--mode", choices=("real_time", "fast"), default=None,
                         help="--nav: only the suites' real-time or fast runs")
     parser.add_argument("--hogs", type=int, default=int(os.environ.get("HOGS", "0")),
-                        help="--nav: this many CPU-bound processes beside the suites (a busy machine)")
+                        help="this many CPU-bound processes beside the rostest suites (a busy machine, e.g. --only view --hogs 2)")
     args = parser.parse_args()
     if args.nav:
         return run_nav(args)
@@ -321,13 +321,21 @@ def main():
     # next to a fast-mode suite, which keeps a core busy, their bounds would measure the neighbour.
     timed = [t for t in suites if TIMING_MARK in open(t).read()]
     phases = [[t for t in suites if t not in timed], timed]
-    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        for phase in phases:
-            for name, p, f, s, n, secs in pool.map(run_rostest, phase):
-                skips = f", {s} skipped: {_skip_reason(name)}" if s else ""
-                say(f"[tests] rostest {name}: {p} passed, {f} failed{skips} ({secs:.0f} s)")
-                total_p, total_f, total_s = total_p + p, total_f + f, total_s + s
-                failures += n
+    hogs = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(args.hogs)]
+    if hogs:
+        say(f"[tests] {len(hogs)} CPU hogs running beside the suites")
+    try:
+        with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+            for phase in phases:
+                for name, p, f, s, n, secs in pool.map(run_rostest, phase):
+                    skips = f", {s} skipped: {_skip_reason(name)}" if s else ""
+                    say(f"[tests] rostest {name}: {p} passed, {f} failed{skips} ({secs:.0f} s)")
+                    total_p, total_f, total_s = total_p + p, total_f + f, total_s + s
+                    failures += n
+    finally:
+        for hog in hogs:
+            hog.kill()
+            hog.wait()
     for name in failures:
         say(f"[tests] FAILED: {name}")
     line = f"{total_p} passed, {total_f} failed"

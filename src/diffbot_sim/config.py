@@ -34,6 +34,7 @@ class SimConfig:
     wait_for_nodes_ignore: List[str] = field(default_factory=lambda: ["/rviz*", "/rqt*"])  # caller-id patterns
     send_timeout: float = 0.5  # s (wall); a subscriber that takes no data for this long is disconnected
     clock_rate: float = 100.0  # Hz of /clock, in sim time
+    clock_max_wall_rate: float = 500.0  # Hz (wall): /clock at most this often; a faster run coalesces ticks; 0: no cap
     cmd_vel_timeout: float = 0.0  # s; 0 holds the last command (Gazebo); > 0 brakes on stale commands
     max_wheel_velocity: float = 0.0  # rad/s; 0: the URDF <limit velocity>, else FALLBACK_MAX_WHEEL_VELOCITY
     gravity: float = -9.81  # m/s^2 along z
@@ -191,6 +192,7 @@ def sim_config(params):
     cfg.time_step = check_number(name("time_step"), cfg.time_step, low=1e-5, high=0.05)
     cfg.real_time_factor = check_number(name("real_time_factor"), cfg.real_time_factor, low=1e-3)
     cfg.clock_rate = check_number(name("clock_rate"), cfg.clock_rate, low=1e-3)
+    cfg.clock_max_wall_rate = check_number(name("clock_max_wall_rate"), cfg.clock_max_wall_rate, low=0.0)
     cfg.fast_batch = check_number(name("fast_batch"), cfg.fast_batch, low=0.0, high=0.1)
     cfg.send_timeout = check_number(name("send_timeout"), cfg.send_timeout, low=0.01)
     cfg.wait_for_nodes_timeout = check_number(name("wait_for_nodes_timeout"), cfg.wait_for_nodes_timeout, low=0.0)

@@ -331,7 +331,7 @@ def test_sim_config_values_and_coercion():
     ("time_step", True), ("time_step", "fast"), ("gui", "maybe"), ("real_time", 2),
     ("cmd_vel_timeout", -1), ("clock_rate", 0), ("gravity", float("inf")), ("model", 3),
     ("publish_ground_truth", "yes please"), ("fast_batch", -0.001), ("fast_batch", 0.5),
-    ("send_timeout", 0), ("send_timeout", "never"),
+    ("send_timeout", 0), ("send_timeout", "never"), ("clock_max_wall_rate", -1),
 ])
 def test_sim_config_rejects(key, value):
     with pytest.raises(ConfigError) as info:

@@ -3,6 +3,7 @@ what is due and publishes /clock and /tf (rospy). Subscriber and service callbac
 (``call``/``post``); it knows no plugin by name."""
 import math
 import socket
+import sys
 import threading
 import time
 
@@ -21,6 +22,12 @@ from diffbot_sim.simulator.throttle import Throttle
 RTF_REPORT_PERIOD = 30.0
 #: Wall seconds a service request may wait for the loop (gazebo_ros's deleteModel waits 60 s for the world).
 CALL_TIMEOUT = 60.0
+#: Wall seconds the loop's thread keeps the interpreter lock before handing it to a waiting rospy thread
+#: (Python's default is 5 ms). PyBullet's calls keep the lock, so in fast mode the loop holds it all the time
+#: but for these hand-overs; a service call or a new connection crosses a dozen of them (accept, header,
+#: request, hand-over to the loop, reply), each a full interval late: at 5 ms, reset_simulation took
+#: 46-154 ms. See performance.md for the figures at this value.
+GIL_SWITCH_INTERVAL = 0.0005
 
 
 class SubscriberLinks:
@@ -162,6 +169,10 @@ class Simulator:
         self.robots = []
         self.clock_period = 1.0 / cfg.clock_rate
         self.next_clock = 0.0
+        # /clock's wall-time floor (see _publish_clock): ticks closer than this in wall time are coalesced
+        self.clock_min_gap = 1.0 / cfg.clock_max_wall_rate if cfg.clock_max_wall_rate > 0 else 0.0
+        self._clock_wall = -math.inf  # wall time of the last /clock published
+        self._clock_coalesced = False  # a tick was left out since the last one published
         self._next_publish = 0.0  # sim time of the earliest publication due, over clock and every robot
         self._tf_msg = ros_msgs.tf_message([])
         self._clock_msg = ros_msgs.clock(rospy.Time(0))
@@ -320,6 +331,7 @@ class Simulator:
     def run(self):
         cfg = self.cfg
         dt = cfg.time_step
+        sys.setswitchinterval(GIL_SWITCH_INTERVAL)
         for runtime in self.robots:
             runtime.start(self.sim_time)
         self._publish_clock(self.sim_time)
@@ -384,7 +396,10 @@ class Simulator:
             self.api.after_step(now, stamp)
         ticked = now + 1e-9 >= self.next_clock
         if ticked:
-            self._publish_clock(now)
+            # Nodes in the loop see every tick (their timers run on it; the simulator waits for them after each);
+            # only a clock nobody waits on is coalesced to the wall-time cap.
+            waits = not self.cfg.real_time and self.cfg.wait_for_nodes and self.sync.in_loop()
+            ticked = self._publish_clock(now, None if waits else wall)
         if not self.cfg.real_time and self.cfg.wait_for_nodes:
             self._wait_for_nodes(ticked)
         self._next_publish = min([self.next_clock] + [r.next_publish() for r in self.robots]
@@ -398,6 +413,8 @@ class Simulator:
             self._sensor_pubs = [pub for runtime in self.robots for plugin in runtime.plugins if plugin.sensor
                                  for pub in plugin.publishers()]
         fresh = self.sync.published(self._sensor_pubs)
+        if fresh and self._clock_coalesced:
+            self._send_clock()  # the nodes fed now see a clock as new as the data
         if fresh or (ticked and self.sync.listeners):
             self.links.release()
             self.sync.forget_drops(fresh)
@@ -431,14 +448,34 @@ class Simulator:
         secs, nsecs = divmod(round(self.steps * self.cfg.time_step * 1e9), 1_000_000_000)
         return rospy.Time(secs, nsecs)
 
-    def _publish_clock(self, now):
+    def _publish_clock(self, now, wall=None):
+        """Publish /clock at ``now`` (its tick due); returns whether it was sent.
+
+        With ``wall`` (a tick of the running loop), a tick that comes sooner than ``clock_min_gap`` wall seconds
+        after the last one sent is left out (coalesced: the next one sent carries the newer time). Why: every
+        node with use_sim_time receives every /clock in a Python callback; far above real time (RTF 50 at
+        100 Hz is 5,000 a second) that starves the node's other threads (a service call through a fresh
+        ServiceProxy took 275 ms instead of 5 ms). A node sees /clock at most ``clock_max_wall_rate`` times
+        a wall second, as often as at 5x real time. Nodes in the loop get every tick (``_step_once`` gives no
+        ``wall``): the simulator waits for them after each, so they are never flooded, and their timers fire at
+        the sim times they would at real time. A pause, a reset and a start always publish."""
+        self.next_clock = next_due(self.next_clock, self.clock_period, now)
+        return self._send_clock(wall)
+
+    def _send_clock(self, wall=None):
+        """/clock at the current sim time, unless ``wall`` is given and too soon (see _publish_clock)."""
         stamp = self.stamp()
         if self.owns_clock:
             rospy.rostime._set_rostime(stamp)  # this node's own sim time (see _own_the_clock)
+        if wall is not None and wall - self._clock_wall < self.clock_min_gap:
+            self._clock_coalesced = True
+            return False
+        self._clock_wall = wall if wall is not None else time.monotonic()
+        self._clock_coalesced = False
         if self.clock_pub.get_num_connections():
             self._clock_msg.clock = stamp
             self.clock_pub.publish(self._clock_msg)
-        self.next_clock = next_due(self.next_clock, self.clock_period, now)
+        return True
 
     def close(self):
         self.links.release()

@@ -168,6 +168,14 @@ class NodeSync:
             names |= set(listeners)
         return names
 
+    def in_loop(self):
+        """Whether a node the simulator waits for is subscribed to a sensor topic (alive, not dropped)."""
+        for name in self.watched():
+            node = self._node(name)
+            if node is not None and not node.dropped:
+                return True
+        return False
+
     def busy_nodes(self, now_wall):
         """(name, "busy") of the nodes in the loop that are working now (after a /clock tick woke their
         timers)."""

@@ -20,6 +20,11 @@ def env_model_paths():
     return paths
 
 
+#: ROS_PACKAGE_PATH -> its packages' model directories: read once per process, as gazebo_ros reads them once at
+#: start-up (a walk of every package's manifest costs ~30 ms: every spawn_sdf_model paid it).
+_PACKAGE_MODEL_PATHS = {}
+
+
 def ros_package_model_paths(rospack=None):
     """Model directories ROS packages export as ``<export><gazebo_ros gazebo_model_path="..."/></export>``.
 
@@ -35,14 +40,25 @@ def ros_package_model_paths(rospack=None):
     entries link to a source tree, as this repository's), the path is also tried next to the real manifest.
 
     Args:
-        rospack: a ``rospkg.RosPack`` (a fresh one from ``ROS_PACKAGE_PATH`` when None).
+        rospack: a ``rospkg.RosPack``; None: the packages of ``ROS_PACKAGE_PATH``, read once per process.
 
     Returns:
         directories, first to search first, without duplicates.
     """
     import rospkg  # lazy: the reader itself stays pure
 
-    rospack = rospack or rospkg.RosPack()
+    if rospack is None:
+        key = os.environ.get("ROS_PACKAGE_PATH", "")
+        if key not in _PACKAGE_MODEL_PATHS:
+            _PACKAGE_MODEL_PATHS[key] = _exported_model_paths(rospkg.RosPack())
+        return list(_PACKAGE_MODEL_PATHS[key])
+    return _exported_model_paths(rospack)
+
+
+def _exported_model_paths(rospack):
+    """ros_package_model_paths' walk over ``rospack``'s packages (uncached)."""
+    import rospkg
+
     direct, others = [], []
     for name in rospack.list():
         try:

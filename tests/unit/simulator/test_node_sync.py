@@ -194,6 +194,20 @@ def test_after_a_clock_tick_only_busy_nodes_in_the_loop_are_pending(node_sync):
     assert node_sync.busy_nodes(0.0) == []
 
 
+def test_in_loop_while_a_watched_listener_lives_and_is_not_dropped(node_sync):
+    scan = Pub()
+    assert not node_sync.in_loop()  # nobody ever listened: /clock may be coalesced
+    slam, = watch(node_sync, Node("/slam"))
+    node_sync.nodes["/remote"] = None
+    scan.impl.connections += [Conn("/slam"), Conn("/remote")]
+    sent(node_sync, scan)
+    assert node_sync.in_loop()
+    slam.dropped = True
+    assert not node_sync.in_loop()
+    slam.dropped, slam.is_alive = False, False
+    assert not node_sync.in_loop()
+
+
 def test_forget_drops_waits_again_for_a_node_that_subscribed_anew(node_sync):
     scan = Pub()
     agent, slam = watch(node_sync, Node("/agent"), Node("/slam"))

@@ -416,6 +416,22 @@ def test_ros_package_model_paths_follow_a_linked_manifest(tmp_path):
     assert paths == [str(tmp_path / "source" / "linked" / "worlds" / "models")]
 
 
+def test_ros_package_model_paths_of_the_package_path_are_read_once(tmp_path, monkeypatch):
+    rospkg = pytest.importorskip("rospkg")
+    _package(tmp_path, "alpha_sim", export="${prefix}/models")
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path))
+    made = []
+
+    class CountingRosPack(rospkg.RosPack):
+        def __init__(self, *args, **kwargs):
+            made.append(1)
+            super().__init__(*args, **kwargs)
+    monkeypatch.setattr(rospkg, "RosPack", CountingRosPack)
+    first = ros_package_model_paths()
+    first.append("changed by the caller")
+    assert ros_package_model_paths() == [str(tmp_path / "alpha_sim" / "models")] and len(made) == 1
+
+
 # ------------------------------------------------------------------------------------------ models, links
 
 def test_nested_models_names_poses_and_inherited_static(tmp_path):
