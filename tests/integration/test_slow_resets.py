@@ -14,8 +14,11 @@ registrations there (topics published and subscribed, services) and its connecti
 Judged after a warm-up of the first 10 % of iterations (caches filled, allocator pools grown): memory grows by
 less than MAX_RSS_GROWTH_KIB over the rest; every count is exactly what it was at the end of the warm-up (fds and
 threads read once the last call's connection has closed: until they hold still); every call succeeded; and the
-services stay fast: for each call the median wall time over the last 10 % of iterations is at most
-MAX_SLOWDOWN times that over the second 10 %. FIGURE lines give the calls per second and every checkpoint.
+services stay fast: for each call the quick end of its wall times (the 10th percentile) over the last 10 % of
+iterations is at most MAX_SLOWDOWN times that over the second 10 %. The quick end, not the median: a slowdown the
+simulator causes (something growing with each call) moves every call, the quickest too, while a machine that got
+busier between the two windows moves the median (measured: medians 5.0 -> 7.5 ms with a chroot installing packages
+beside it, the simulator's loop waiting for a CPU 17-24 % of the time). FIGURE lines give the calls per second and every checkpoint.
 """
 import os
 import statistics
@@ -62,6 +65,11 @@ class Checkpoint:
     cpu_wait: float  # s its main thread has waited for a CPU so far (schedstat)
 
     COUNTS = ("fds", "threads", "tf_listeners", "registrations", "connections")
+
+
+def quick_end(times):
+    """The 10th percentile of ``times``: how fast a call is when the machine lets it be."""
+    return statistics.quantiles(times, n=10)[0]
 
 
 def pose(x, y, z):
@@ -154,13 +162,13 @@ class Resets(unittest.TestCase):
 
     @staticmethod
     def report(point, previous, times, every):
-        window = {name: statistics.median(t[-every:]) * 1e3 for name, t in times.items()}
+        window = {name: (statistics.median(t[-every:]) * 1e3, quick_end(t[-every:]) * 1e3) for name, t in times.items()}
         span = point.wall - previous.wall
         waited = 100.0 * (point.cpu_wait - previous.cpu_wait) / span if span > 0 else 0.0
         figure(f"resets checkpoint {point.done}: RSS {point.rss_kib / 1024:.1f} MB, fds {point.fds}, threads "
                f"{point.threads}, TF listeners {point.tf_listeners}, registrations {point.registrations}, "
                f"connections {point.connections}; {3 * every / span:.0f} calls/s; median ms "
-               + ", ".join(f"{name} {ms:.2f}" for name, ms in window.items())
+               + ", ".join(f"{name} {ms:.2f} (p10 {p10:.2f})" for name, (ms, p10) in window.items())
                + f"; the simulator's loop waited for a CPU {waited:.0f} % of the time")
 
     def judge(self, checkpoints, times, failures, every):
@@ -177,10 +185,10 @@ class Resets(unittest.TestCase):
                              f"the simulator's {count} changed after the warm-up: "
                              + " ".join(f"{c.done}:{getattr(c, count)}" for c in checkpoints))
         for name, spent in times.items():
-            second, last = statistics.median(spent[every:2 * every]), statistics.median(spent[-every:])
+            second, last = quick_end(spent[every:2 * every]), quick_end(spent[-every:])
             self.assertLessEqual(last, MAX_SLOWDOWN * second,
-                                 f"{name} slowed down: median {1e3 * last:.2f} ms over the last {every} calls, "
-                                 f"{1e3 * second:.2f} ms over the second {every}")
+                                 f"{name} slowed down: 10th percentile {1e3 * last:.2f} ms over the last {every} "
+                                 f"calls, {1e3 * second:.2f} ms over the second {every}")
 
 
 if __name__ == "__main__":
