@@ -3,6 +3,7 @@ runs that fail, hang past their timeout, or are stopped by Ctrl-C; and the same 
 cluster started on this machine (Ray's own test-cluster helper: a head and a worker node, loopback, no
 dashboard), whose results must show runs on both nodes, and a run whose Ray worker is killed mid-run run
 again on the other node and recorded once. Every run's processes must be gone after."""
+import contextlib
 import glob
 import json
 import os
@@ -31,11 +32,18 @@ def batch_processes():
     return pids
 
 
+def _as_a_terminal_starts_it():
+    """Ctrl-C's default action, as a terminal's foreground job has it. Started in the background by a script
+    (`make test &`, a CI wrapper), the tests inherit SIGINT ignored, and Python then never raises
+    KeyboardInterrupt: a batch would not stop at Ctrl-C because of how the tests were started."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def batch(args, **kw):
     """`rosrun diffbot_sim batch ...` from a fresh bash that sources the workspace (a user's new terminal)."""
     cmd = f"source {SETUP} && exec rosrun diffbot_sim batch " + " ".join(args)
     return subprocess.Popen(["bash", "-c", cmd], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True, **kw)
+                            start_new_session=True, preexec_fn=_as_a_terminal_starts_it, **kw)
 
 
 def records(out):
@@ -133,7 +141,18 @@ scenarios:
                                                   for p in batch_processes() if os.path.exists(f"/proc/{p}")):
         time.sleep(0.2)  # a hanging run has started its child
     os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C reaches the terminal's whole process group
-    _, stderr = proc.communicate(timeout=60)
+    try:
+        _, stderr = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        # Where it is stuck (batch dumps its threads on SIGUSR1), then nothing of it left for the next tests.
+        os.killpg(proc.pid, signal.SIGUSR1)
+        time.sleep(2.0)
+        os.killpg(proc.pid, signal.SIGKILL)
+        _, stderr = proc.communicate(timeout=30)
+        for pid in batch_processes():
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+        pytest.fail(f"batch did not end within 60 s of Ctrl-C; its threads then:\n{stderr[-6000:]}")
     assert proc.returncode == 130, stderr
     assert list(records(out)) == ["quick"]  # the stopped runs are not recorded: a resume runs them
     deadline = time.monotonic() + 10

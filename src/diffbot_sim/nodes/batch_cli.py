@@ -8,8 +8,10 @@ Writes DIR/results.jsonl (a record per run, as each ends), DIR/junit.xml, DIR/su
 results so far are kept). Not a rospy node: every run's ROS processes are its children.
 """
 import argparse
+import faulthandler
 import os
 import re
+import signal
 import sys
 import time
 import uuid
@@ -48,6 +50,8 @@ def say(text):
 @entry_point
 def main(argv=None):
     """Entry point of ``rosrun diffbot_sim batch``; returns the exit status."""
+    # `kill -USR1 <pid>` prints where every thread of a batch that seems stuck is (on standard error).
+    faulthandler.register(signal.SIGUSR1, all_threads=True)
     args = _parser().parse_args(sys.argv[1:] if argv is None else argv)
     if args.jobs < 1:
         say(f"batch: --jobs {args.jobs}: must be at least 1")
