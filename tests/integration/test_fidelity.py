@@ -40,7 +40,6 @@ class FidelityTest(unittest.TestCase):
 
     def test_straight_2m(self):
         rec = self.rec
-        t0 = rec.sim_time()
         rec.send(0.2, 0.0)
         rec.wait(lambda: rec.last(rec.odom).pose.pose.position.x >= 2.0, 120.0, "2 m travelled")
         rec.send(0.0, 0.0)

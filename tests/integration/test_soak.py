@@ -116,7 +116,6 @@ class SoakTest(unittest.TestCase):
             if rss_start is None and now >= WARM_UP:
                 rss_start = rss_kib(pid)
                 warnings_at_start = self.count_warnings(log_path)
-                warm_wall = time.monotonic()
             if rss_start is not None and time.monotonic() - last_sample >= 1.0:
                 rss_max = max(rss_max, rss_kib(pid))
                 last_sample = time.monotonic()
