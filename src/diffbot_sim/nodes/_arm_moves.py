@@ -4,6 +4,7 @@ command topic), and the body judged after each move with the physics paused: eve
 (/gazebo/get_link_state) against where joint_states + the URDF put it. What to move and how it is judged is
 :mod:`diffbot_sim.check.arm_report` (pure)."""
 import threading
+import time
 
 import rospy
 
@@ -15,6 +16,26 @@ MOVE_TIME = 1.0  # s (sim): a trajectory goal's one point
 RESULT_TIMEOUT = 15.0  # s (sim) for a goal's result
 SETTLE_TIMEOUT = 5.0  # s (sim) for the joints to come to rest after a move
 AT_REST = 0.02  # rad/s (m/s): the moved joints' joint_states velocities below this count as at rest
+
+
+def wait_for_goal(client, timeout):
+    """Wait up to ``timeout`` s of sim time for the goal a SimpleActionClient just sent to end; True when it did.
+
+    Instead of ``client.wait_for_result``: actionlib's SimpleActionClient drops the transitions of a goal that
+    ends before ``send_goal`` has stored its handle, and then waits PENDING for ever; a goal already met (a
+    gripper told to open when open) ends that fast in fast mode. The goal handle itself has them all, and
+    ``get_state``/``get_result`` read it."""
+    from actionlib import CommState
+
+    deadline = rospy.get_time() + timeout
+    while not rospy.is_shutdown():
+        handle = client.gh
+        if handle is not None and handle.get_comm_state() == CommState.DONE:
+            return True
+        if rospy.get_time() > deadline:
+            return False
+        time.sleep(0.002)  # wall: polling the handle, not waiting for sim time
+    return False
 
 
 class _JointStates:
@@ -107,7 +128,7 @@ class _Sender:
     def _finish(self, client):
         from actionlib_msgs.msg import GoalStatus
 
-        if not client.wait_for_result(rospy.Duration(RESULT_TIMEOUT)):
+        if not wait_for_goal(client, RESULT_TIMEOUT):
             client.cancel_goal()
             return "no result"
         result = client.get_result()

@@ -25,6 +25,7 @@ from diffbot_sim.check.arm_check import forward_kinematics
 from diffbot_sim.control import pick_place as pp
 from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.errors import ConfigError, DiffbotSimError
+from diffbot_sim.nodes._arm_moves import wait_for_goal
 from diffbot_sim.nodes._entry import entry_point
 from diffbot_sim.transforms import yaw_from_quaternion
 from diffbot_sim.values import check_number, check_string
@@ -119,7 +120,7 @@ class Robot:
         goal.trajectory.points = [JointTrajectoryPoint(positions=list(step.target),
                                                        time_from_start=rospy.Duration.from_sec(step.duration))]
         self.arm.send_goal(goal)
-        if not self.arm.wait_for_result(rospy.Duration.from_sec(step.duration + self.step_timeout)):
+        if not wait_for_goal(self.arm, step.duration + self.step_timeout):
             self.arm.cancel_goal()
             raise StepFailed(f"{step.name}: no result within {step.duration + self.step_timeout:g} s")
         state, result = self.arm.get_state(), self.arm.get_result()
@@ -135,7 +136,7 @@ class Robot:
         goal = GripperCommandGoal()
         goal.command.position, goal.command.max_effort = step.target
         self.gripper.send_goal(goal)
-        if not self.gripper.wait_for_result(rospy.Duration.from_sec(self.step_timeout)):
+        if not wait_for_goal(self.gripper, self.step_timeout):
             self.gripper.cancel_goal()
             raise StepFailed(f"{step.name}: no result within {self.step_timeout:g} s")
         state, result = self.gripper.get_state(), self.gripper.get_result()
