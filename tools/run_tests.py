@@ -14,6 +14,7 @@ the machine's, not a neighbour's; then the shipped navigation batch (examples/ba
 """
 import argparse
 import concurrent.futures
+import contextlib
 import glob
 import os
 import shutil
@@ -226,15 +227,8 @@ def run_nav(args):
     failures = []
     modes = [m for m in (("real_time", args.jobs), ("fast", 1)) if args.mode in (None, m[0])]
     for mode, jobs in modes:
-        hogs = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(args.hogs)]
-        if hogs:
-            say(f"[tests] {len(hogs)} CPU hogs running beside the {mode} suites")
-        try:
+        with cpu_hogs(args.hogs, f"the {mode} suites"):
             results = _run_suites(suites, mode, jobs)
-        finally:
-            for hog in hogs:
-                hog.kill()
-                hog.wait()
         for name, p, f, s, n, secs in results:
             say(f"[tests] rostest {name}: {p} passed, {f} failed ({secs:.0f} s)")
             for line in _figures(name):
@@ -248,6 +242,20 @@ def run_nav(args):
         say(f"[tests] FAILED: {name}")
     say(f"{total_p} passed, {total_f} failed")
     return 1 if total_f else 0
+
+
+@contextlib.contextmanager
+def cpu_hogs(count, beside):
+    """``count`` CPU-bound processes while the block runs (a busy machine), ended after it."""
+    hogs = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(count)]
+    if hogs:
+        say(f"[tests] {len(hogs)} CPU hogs running beside {beside}")
+    try:
+        yield
+    finally:
+        for hog in hogs:
+            hog.kill()
+            hog.wait()
 
 
 def _run_suites(suites, mode, jobs):
@@ -321,21 +329,13 @@ def main():
     # next to a fast-mode suite, which keeps a core busy, their bounds would measure the neighbour.
     timed = [t for t in suites if TIMING_MARK in open(t).read()]
     phases = [[t for t in suites if t not in timed], timed]
-    hogs = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(args.hogs)]
-    if hogs:
-        say(f"[tests] {len(hogs)} CPU hogs running beside the suites")
-    try:
-        with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-            for phase in phases:
-                for name, p, f, s, n, secs in pool.map(run_rostest, phase):
-                    skips = f", {s} skipped: {_skip_reason(name)}" if s else ""
-                    say(f"[tests] rostest {name}: {p} passed, {f} failed{skips} ({secs:.0f} s)")
-                    total_p, total_f, total_s = total_p + p, total_f + f, total_s + s
-                    failures += n
-    finally:
-        for hog in hogs:
-            hog.kill()
-            hog.wait()
+    with cpu_hogs(args.hogs, "the suites"), concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        for phase in phases:
+            for name, p, f, s, n, secs in pool.map(run_rostest, phase):
+                skips = f", {s} skipped: {_skip_reason(name)}" if s else ""
+                say(f"[tests] rostest {name}: {p} passed, {f} failed{skips} ({secs:.0f} s)")
+                total_p, total_f, total_s = total_p + p, total_f + f, total_s + s
+                failures += n
     for name in failures:
         say(f"[tests] FAILED: {name}")
     line = f"{total_p} passed, {total_f} failed"
