@@ -16,6 +16,7 @@ import argparse
 import concurrent.futures
 import contextlib
 import glob
+import html
 import os
 import shutil
 import signal
@@ -67,15 +68,19 @@ TIMING_MARK = "diffbot_sim: timing-sensitive"
 
 
 def _why(element):
-    """The gist of a JUnit failure: its message, else the last line of its text (an assertion, usually)."""
+    """The gist of a JUnit failure: its message, else the exception's text (rosunit writes ``str(exception)``
+    and then the traceback), with the traceback's last line, where the failure was raised. Long enough to
+    hold a roslaunch log tail that an assertion quotes: CI shows only the end of the output."""
     text = (element.get("message") or "").strip()
     body = (element.text or "").strip()
     if body:
-        text = text or body.splitlines()[-1]
-        last = body.splitlines()[-1].strip()
+        lines = body.splitlines()
+        first_frame = next((i for i, line in enumerate(lines) if line.startswith('  File "')), len(lines))
+        text = text or " ".join(lines[:first_frame]) or lines[-1]
+        last = lines[-1].strip()
         if last not in text:
             text = f"{text} | {last}"
-    return " ".join(text.split())[:400] or "(no message)"
+    return " ".join(text.split())[:1500] or "(no message)"
 
 
 def count_junit(paths):
@@ -287,12 +292,14 @@ def run_nav_batch():
     return passed, failed, names
 
 
-def _figures(name):
-    """The FIGURE lines a suite's test printed (kept in its result files): its measured figures."""
+def _figures(name, mark="FIGURE "):
+    """The lines starting with ``mark`` a suite's test printed (kept in its result files): its measured
+    figures, or (``RETRIED ``) a start-up it had to repeat for a reason outside the project (the report
+    shows each, so a run that needed one says so)."""
     lines = []
     for path in sorted(glob.glob(os.path.join(RESULTS, "rostest", name, "**", "rosunit-*.xml"), recursive=True)):
         with open(path, errors="replace") as result:
-            lines += [line.strip() for line in result if line.startswith("FIGURE ")]
+            lines += [html.unescape(line.strip()) for line in result if line.startswith(mark)]
     return lines
 
 
@@ -334,6 +341,8 @@ def main():
             for name, p, f, s, n, secs in pool.map(run_rostest, phase):
                 skips = f", {s} skipped: {_skip_reason(name)}" if s else ""
                 say(f"[tests] rostest {name}: {p} passed, {f} failed{skips} ({secs:.0f} s)")
+                for line in _figures(name, "RETRIED "):
+                    say(f"[tests]   {line}")
                 total_p, total_f, total_s = total_p + p, total_f + f, total_s + s
                 failures += n
     for name in failures:

@@ -70,7 +70,7 @@ class ViewGui(viewtest.PictureSuite):
                       "the simulator to load the world (/bullet_sim/world_bodies)")
         cls.view.wait(lambda: cls.view.last_odom() is not None, START_TIMEOUT, "odometry")
         for name in ("set_model_state", "get_model_state", "get_world_properties", "delete_model"):
-            cls.view.wait(lambda: cls.service_up(f"/gazebo/{name}"), START_TIMEOUT, f"/gazebo/{name}")
+            cls.view.wait(lambda: cls.view.service_up(f"/gazebo/{name}"), START_TIMEOUT, f"/gazebo/{name}")
         cls.set_state = rospy.ServiceProxy("/gazebo/set_model_state", SetModelState)
         cls.get_state = rospy.ServiceProxy("/gazebo/get_model_state", GetModelState)
         cls.world_properties = rospy.ServiceProxy("/gazebo/get_world_properties", GetWorldProperties)
@@ -85,14 +85,6 @@ class ViewGui(viewtest.PictureSuite):
             return xscreen.find_window(display, "Bullet Physics")
         except subprocess.TimeoutExpired:
             return None
-
-    @staticmethod
-    def service_up(name):
-        try:
-            rospy.wait_for_service(name, 0.2)
-            return True
-        except rospy.ROSException:
-            return False
 
     def crashed(self):
         """After something went missing (the window, a service): fail naming roslaunch's exit when it ends

@@ -15,7 +15,7 @@ import rostest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import viewtest  # noqa: E402
-from test_view_rviz import START_TIMEOUT, ViewRviz  # noqa: E402
+from test_view_rviz import ViewRviz  # noqa: E402
 
 ROBOT2 = (0.0, 1.0)  # m, multi.launch's spawn pose of robot2; robot1 (the fixed frame's) is at the origin
 
@@ -25,10 +25,9 @@ class ViewMulti(ViewRviz):
     def setUpClass(cls):
         rospy.init_node("test_view_multi")
         if not cls.start_view("view_multi", viewtest.View([f"world:={viewtest.WORLD}"], "view_multi_launch",
-                                                          launch="view_multi.launch")):
+                                                          launch="view_multi.launch"), ready=cls.rviz_up):
             return
         cls.tmp = tempfile.mkdtemp(prefix="view_multi_")
-        cls.view.wait(lambda: cls.rviz_window(), START_TIMEOUT, "the rviz window")
         cls.config = viewtest.generated_config()  # written by view_rviz before it started rviz
         current = cls.config["Visualization Manager"]["Views"]["Current"]
         cls.center, cls.scale = (current["X"], current["Y"]), current["Scale"]

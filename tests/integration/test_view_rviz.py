@@ -53,10 +53,9 @@ class ViewRviz(viewtest.PictureSuite):
     def setUpClass(cls):
         rospy.init_node("test_view_rviz")
         if not cls.start_view("view_rviz", viewtest.View([f"model:={viewtest.ROBOT}", f"world:={viewtest.WORLD}"],
-                                                         "view_rviz_launch")):
+                                                         "view_rviz_launch"), ready=cls.rviz_up):
             return
         cls.tmp = tempfile.mkdtemp(prefix="view_rviz_")
-        cls.view.wait(lambda: cls.rviz_window(), START_TIMEOUT, "the rviz window")
         cls.view.wait(lambda: cls.view.last_odom() is not None, START_TIMEOUT, "odometry")
         cls.config = viewtest.generated_config()
         current = cls.config["Visualization Manager"]["Views"]["Current"]
@@ -68,6 +67,20 @@ class ViewRviz(viewtest.PictureSuite):
     # ------------------------------------------------------------------------------------- helpers
 
     @classmethod
+    def rviz_up(cls):
+        """rviz started: its window at its configured size, its services (advertised right after rviz shows the
+        window), and its first settled view (``settled``): the start-up in which a death of rviz itself is
+        met by starting the view once more (``PictureSuite.start_view``)."""
+        started = time.monotonic()
+        cls.view.wait(lambda: cls.rviz_window(), START_TIMEOUT, "the rviz window")
+        window = time.monotonic() - started
+        cls.view.wait(lambda: cls.view.service_up("/rviz/load_config_discarding_changes"), 20.0, "rviz's services")
+        services = time.monotonic() - started
+        cls.settled("rviz started")
+        print(f"rviz up: its window after {window:.1f} s, its services after {services:.1f} s, settled (every "
+              f"display Ok) after {time.monotonic() - started:.1f} s (from the launch's start)", flush=True)
+
+    @classmethod
     def rviz_window(cls, windows=None):
         """rviz's main window once it has its configured size (it opens at 640 x 480 first)."""
         for window in cls.view.windows() if windows is None else windows:
@@ -75,12 +88,13 @@ class ViewRviz(viewtest.PictureSuite):
                 return window
         return None
 
-    def layout(self):
+    @classmethod
+    def layout(cls):
         """(rviz window, 3-D view panel, status mask over the screen: the left dock without render panels), or
         a sentence saying what is missing (rviz maps, resizes and re-parents its windows while it starts and
         while it loads a config: a missing window is "not yet", not a failure)."""
-        windows = self.view.windows()
-        top = self.rviz_window(windows)
+        windows = cls.view.windows()
+        top = cls.rviz_window(windows)
         if top is None:
             names = sorted({w.name for w in windows if w.name})[:8]
             return f"no rviz window of {xscreen.SCREEN[0]}x{xscreen.SCREEN[1]} (named windows: {names})"
@@ -96,7 +110,8 @@ class ViewRviz(viewtest.PictureSuite):
             mask[y0:y1, x0:x1] = False
         return top, view, mask
 
-    def settled(self, what):
+    @classmethod
+    def settled(cls, what):
         """Wait until rviz shows what it was told to, at rest; return (frame, 3-D view panel).
 
         Three conditions, each named in the failure message when it is the one that never held:
@@ -110,18 +125,18 @@ class ViewRviz(viewtest.PictureSuite):
           screenshot taking longer than a scan period) two screenshots never span the same scan.
         """
         history = []  # (wall time, view box, view pixels, laser-point mask) of the screenshots so far
-        self.why = "no screenshot taken"
+        cls.why = "no screenshot taken"
 
         def ready():
-            found = self.layout()
+            found = cls.layout()
             if isinstance(found, str):
-                self.why, history[:] = found, []
+                cls.why, history[:] = found, []
                 return None
             _, view, mask = found
-            frame = self.view.screenshot()
+            frame = cls.view.screenshot()
             status = xscreen.status_colors(frame, mask)
             if status["warn"] or status["error"] or not status["ok"]:
-                self.why, history[:] = f"display status colours {status} (Ok > 0, Warn and Error 0 wanted)", []
+                cls.why, history[:] = f"display status colours {status} (Ok > 0, Warn and Error 0 wanted)", []
                 return None
             pixels = xscreen.crop(frame, view.box())
             history.append((time.monotonic(), view.box(), pixels, xscreen.greenish(pixels)))
@@ -137,7 +152,7 @@ class ViewRviz(viewtest.PictureSuite):
                     viewtest.save_frame(other, "settle_before")
                     viewtest.save_frame(pixels, "settle_after")
             if moved < 0 or moved > SETTLE_CHANGED:
-                self.why = ("the 3-D panel moved or was resized" if moved < 0 else
+                cls.why = ("the 3-D panel moved or was resized" if moved < 0 else
                             f"the 3-D view changed in {moved} pixels (> {SETTLE_CHANGED}) outside the laser points between "
                             "screenshots, "
                             f"within the panel's pixels {where} (rviz still drawing, or something still moving; "
@@ -145,16 +160,16 @@ class ViewRviz(viewtest.PictureSuite):
                 history[:] = history[-1:]
                 return None
             if len(history) < 2 or now - history[0][0] < STABLE_WALL:
-                self.why = f"the 3-D view unchanged for {now - history[0][0]:.1f} s of the {STABLE_WALL:g} s wanted"
+                cls.why = f"the 3-D view unchanged for {now - history[0][0]:.1f} s of the {STABLE_WALL:g} s wanted"
                 return None
             return frame, view
         started = time.monotonic()
         try:
-            found = self.view.wait(ready, SETTLE_TIMEOUT, what)
+            found = cls.view.wait(ready, SETTLE_TIMEOUT, what)
             print(f"{what}: settled in {time.monotonic() - started:.1f} s", flush=True)
             return found
         except AssertionError as err:
-            raise AssertionError(f"{what}: {self.why} ({err})") from None
+            raise AssertionError(f"{what}: {cls.why} ({err})") from None
 
     def robot_patch(self, with_model, without_model, view):
         """The pixels the RobotModel display changes: ``(count, centroid, stray)``. Laser points are left
