@@ -12,6 +12,8 @@ TOLERANCE of the real-time run's (measured 0.6-1.7 cm, once 16 cm; with ~wait_fo
 import collections
 import math
 import os
+import signal
+import subprocess
 import sys
 import threading
 import time
@@ -25,6 +27,7 @@ from gazebo_msgs.srv import SetPhysicsProperties
 from geometry_msgs.msg import Twist, Vector3
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
+from std_msgs.msg import Bool
 from std_srvs.srv import Empty
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -36,6 +39,8 @@ RUN = 12.0  # s of sim time
 # path 16 cm away in 10 runs; unbounded fast mode misses by 1.2 m.
 TOLERANCE = 0.25
 TIME_STEP = 1.0 / 240.0
+ODOM_TOLERANCE = 0.10  # m: the odometry follower's fast path vs its real-time one (see its test)
+HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 class WallFollower:
@@ -52,6 +57,14 @@ class WallFollower:
     def _keep(self, msg):
         self.scans.append(msg)
         self.scan = msg
+
+    def start(self):
+        self.scans.clear()  # the last run's, stamped in the sim time before the reset
+        self.active = True
+
+    def stop(self):
+        self.active = False
+        self.cmd.publish(Twist())
 
     def _scan_before(self, now):
         """The newest scan stamped at least half a tick before ``now``. Every other tick falls on a scan's
@@ -83,6 +96,41 @@ class WallFollower:
         self.cmd.publish(twist)
 
 
+class OdomFollowerProcess:
+    """odom_follower.py in its own process (its own node: the simulator sees who publishes cmd_vel), switched by
+    /odom_follower/active."""
+
+    def __init__(self):
+        self.switch = rospy.Publisher("/odom_follower/active", Bool, queue_size=1, latch=True)
+        self.proc = subprocess.Popen([sys.executable, os.path.join(HERE, "odom_follower.py")],
+                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                     start_new_session=True)
+        rospy.on_shutdown(self.close)
+        first = self.proc.stdout.readline().strip()  # READY once its /cmd_vel reaches the simulator
+        if first != "READY":
+            raise AssertionError(f"odom_follower.py did not start: {first!r} (exit {self.proc.poll()})")
+        wait_for(lambda: self.switch.get_num_connections() > 0, 30, "odom_follower to subscribe its switch")
+
+    def start(self):
+        self.alive()
+        self.switch.publish(Bool(True))
+
+    def stop(self):
+        self.switch.publish(Bool(False))
+
+    def alive(self):
+        if self.proc.poll() is not None:
+            raise AssertionError(f"odom_follower.py exited {self.proc.returncode}: {self.proc.stdout.read()}")
+
+    def close(self):
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGINT)
+            try:
+                self.proc.wait(10)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+
+
 class Truth:
     def __init__(self):
         self.lock = threading.Lock()
@@ -112,21 +160,20 @@ class LoopModes(unittest.TestCase):
         cls.truth = Truth()
         wait_for(lambda: cls.follower.scan is not None, 30, "a first scan")
 
-    def run_once(self, max_update_rate):
-        """Reset, set the pace (max_update_rate: 0 fast, 1/step real time), follow the wall for RUN s; the
-        ground-truth path [(t, x, y)] and the wall time it took."""
-        self.follower.active = False
+    def run_once(self, max_update_rate, controller=None):
+        """Reset, set the pace (max_update_rate: 0 fast, 1/step real time), let ``controller`` (default: the
+        wall follower) drive for RUN s; the ground-truth path [(t, x, y)] and the wall time it took."""
+        controller = controller or self.follower
+        controller.stop()
         self.physics(time_step=TIME_STEP, max_update_rate=max_update_rate, gravity=Vector3(0, 0, -9.8),
                      ode_config=ODEPhysics())
         self.reset()
         wait_for(lambda: rospy.get_time() < 1.0, 10, "sim time back to 0")
         self.truth.take()
-        self.follower.scans.clear()  # the last run's, stamped in the sim time before the reset
         started = time.monotonic()
-        self.follower.active = True
+        controller.start()
         wait_for(lambda: rospy.get_time() >= RUN, 120, f"{RUN} s of sim time")
-        self.follower.active = False
-        self.follower.cmd.publish(Twist())
+        controller.stop()
         return self.truth.take(), time.monotonic() - started
 
     @staticmethod
@@ -148,6 +195,25 @@ class LoopModes(unittest.TestCase):
               "real-time one", flush=True)
         self.assertGreater(travelled, 2.0, "the follower did not drive")
         self.assertLess(d_fast, TOLERANCE, f"fast mode's path left the real-time path by {d_fast:.3f} m")
+        self.assertLess(wall_fast, wall_rt, "fast mode was not faster than real time")
+
+    def test_a_follower_of_odometry_alone_follows_the_real_time_path(self):
+        """A node that reads no sensor topic, only /odom, and publishes cmd_vel (a waypoint tour) is in the loop
+        as a publisher of a command topic: its commands act at the same sim times in fast mode."""
+        square = OdomFollowerProcess()
+        try:
+            reference, wall_rt = self.run_once(1.0 / TIME_STEP, square)
+            fast, wall_fast = self.run_once(0.0, square)
+            square.alive()
+        finally:
+            square.close()
+        travelled = float(np.sum(np.hypot(np.diff(reference[:, 1]), np.diff(reference[:, 2]))))
+        d_fast = self.deviation(reference, fast)
+        print(f"FIGURE loop_modes: odometry follower {RUN:g} s sim ({travelled:.2f} m): real time {wall_rt:.1f} s "
+              f"wall; fast {wall_fast:.1f} s wall ({RUN / wall_fast:.1f}x), path within {d_fast * 100:.1f} cm of "
+              "the real-time one", flush=True)
+        self.assertGreater(travelled, 2.0, "the odometry follower did not drive")
+        self.assertLess(d_fast, ODOM_TOLERANCE, f"fast mode's path left the real-time path by {d_fast:.3f} m")
         self.assertLess(wall_fast, wall_rt, "fast mode was not faster than real time")
 
 

@@ -184,6 +184,7 @@ class Simulator:
         self.actors = None  # the world's <actor>s (simulator.actors.Actors), when it has any
         self.sync = NodeSync(cfg.wait_for_nodes_timeout, cfg.wait_for_nodes_ignore, rospy.get_name(), self.warn)
         self._sensor_pubs = None  # the sensor plugins' publishers (NodeSync), rebuilt when robots change
+        self._next_commander_scan = 0.0  # wall time of the next look at who publishes commands (NodeSync)
         self._rtf_mark = None  # (wall, sim, waited) at the last achieved-RTF report
 
     def publishers(self):
@@ -413,13 +414,26 @@ class Simulator:
             self._sensor_pubs = [pub for runtime in self.robots for plugin in runtime.plugins if plugin.sensor
                                  for pub in plugin.publishers()]
         fresh = self.sync.published(self._sensor_pubs)
+        if ticked:
+            wall = time.monotonic()
+            if wall >= self._next_commander_scan:  # who publishes commands changes rarely: looked at 10 times a s
+                self._next_commander_scan = wall + 0.1
+                self.sync.note_commanders(self._command_subscribers())
         if fresh and self._clock_coalesced:
             self._send_clock()  # the nodes fed now see a clock as new as the data
-        if fresh or (ticked and self.sync.listeners):
+        if fresh or (ticked and (self.sync.listeners or self.sync.commanders)):
             self.links.release()
             self.sync.forget_drops(fresh)
             self.sync.wait(fresh, self._serve_while_held, lambda: self.paused or rospy.is_shutdown())
         self._report_rtf()
+
+    def _command_subscribers(self):
+        """The simulator's subscriptions that command it: every robot's (cmd_vel, controller commands) and the
+        world API's (set_model_state, set_link_state)."""
+        handles = [h for runtime in self.robots for h in runtime.ctx.handles]
+        if self.api is not None:
+            handles += self.api.handles
+        return [h for h in handles if isinstance(h, rospy.Subscriber)]
 
     def _serve_while_held(self):
         """Requests keep being served while sim time is held (a reset, a spawn, a step-and-wait client's

@@ -7,7 +7,9 @@ three scans in four; a step-and-wait client held each action for a random stretc
 picked for one machine is too fast on a slower or busier one and wastes time on a faster one.
 
 How (``~wait_for_nodes``, on by default whenever the simulator is not paced to the wall clock): the nodes in the
-loop are the subscribers of its sensor topics (lasers, rangers, point clouds, cameras). After a step that
+loop are the subscribers of its sensor topics (lasers, rangers, point clouds, cameras) and the publishers of its
+command topics (``cmd_vel``, controller commands, ``/gazebo/set_model_state``): a node that steers the robot by
+odometry or TF alone (a waypoint tour, a path follower) acts on the clock as at real time too. After a step that
 published /clock, sim time holds until none of them is busy (their timers, woken by the tick, have run); after
 one that published on a sensor topic, until every node that was subscribed to it
 
@@ -98,6 +100,7 @@ class NodeSync:
         self.nodes = {}  # caller id -> WatchedNode, or None (not watchable: other host, ignored, gone)
         self.listeners = {}  # publisher -> {caller id: (its connection, fresh)} when it last published
         self._connections = {}  # publisher -> the connections it had at its previous message
+        self.commanders = set()  # caller ids publishing to the simulator's command topics (note_commanders)
         self.seq = {}  # publisher -> its message count when last looked at
         self.waited = 0.0  # wall seconds spent waiting, for the achieved-RTF report
         self.holds = 0
@@ -161,9 +164,23 @@ class NodeSync:
                     fresh.append(pub)
         return fresh
 
-    def watched(self):
-        """Every node subscribed to a sensor topic when it last published: the nodes in the loop."""
+    def note_commanders(self, subscribers):
+        """Take the publishers connected to ``subscribers`` (the simulator's command topics) as nodes in the
+        loop: after each /clock tick sim time holds until they are idle, as it does for the sensor listeners.
+        A node found by its caller id as the publisher named itself in the connection's header."""
         names = set()
+        for sub in subscribers:
+            impl = getattr(sub, "impl", None)
+            for conn in list(impl.connections) if impl is not None else ():
+                name = getattr(conn, "callerid_pub", None)
+                if name and name != "unknown":  # rospy's value before the header is read
+                    names.add(name)
+        self.commanders = names
+
+    def watched(self):
+        """The nodes in the loop: every node subscribed to a sensor topic when it last published, and every
+        publisher to a command topic."""
+        names = set(self.commanders)
         for listeners in self.listeners.values():
             names |= set(listeners)
         return names

@@ -194,6 +194,38 @@ def test_after_a_clock_tick_only_busy_nodes_in_the_loop_are_pending(node_sync):
     assert node_sync.busy_nodes(0.0) == []
 
 
+class Sub:
+    """A rospy.Subscriber as note_commanders reads it: ``impl.connections``, each naming its publisher in
+    ``callerid_pub`` (rospy's "unknown" until the connection header is read)."""
+
+    def __init__(self, *callers):
+        self.impl = Impl()
+        for caller in callers:
+            conn = Conn(None)
+            conn.callerid_pub = caller
+            self.impl.connections.append(conn)
+
+
+def test_command_publishers_are_in_the_loop_and_waited_for_after_a_tick(node_sync):
+    tour, mover = watch(node_sync, Node("/tour", busy=True), Node("/mover"))
+    assert not node_sync.in_loop()
+    node_sync.note_commanders([Sub("/tour", "unknown"), Sub("/mover"), Sub()])
+    assert node_sync.commanders == {"/tour", "/mover"}  # "unknown": a connection whose header is not read yet
+    assert node_sync.in_loop()
+    assert node_sync.pending([], 0.0) == [("/tour", "busy")]
+    tour.is_busy = False
+    assert node_sync.pending([], 0.0) == []
+    node_sync.note_commanders([Sub()])  # both stopped publishing commands
+    assert not node_sync.in_loop()
+
+
+def test_a_subscriber_that_was_unregistered_has_no_commanders(node_sync):
+    gone = Sub("/tour")
+    gone.impl = None  # rospy.Subscriber.unregister()
+    node_sync.note_commanders([gone])
+    assert node_sync.commanders == set()
+
+
 def test_in_loop_while_a_watched_listener_lives_and_is_not_dropped(node_sync):
     scan = Pub()
     assert not node_sync.in_loop()  # nobody ever listened: /clock may be coalesced
