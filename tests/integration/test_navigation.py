@@ -56,6 +56,7 @@ class Recorder:
         self.avoid = rospy.get_param("~avoid", [])
         self.clearance = {name: math.inf for name in self.avoid}
         self.driving_clearance = dict(self.clearance)
+        self.driving_moment = {name: "" for name in self.avoid}  # where the smallest driving clearance was
         if self.avoid:
             from gazebo_msgs.msg import ModelStates
 
@@ -85,15 +86,23 @@ class Recorder:
             out_along = math.copysign(max(abs(along) - depth / 2, 0.0), along)
             out_across = math.copysign(max(abs(across) - width / 2, 0.0), across)
             gap = math.hypot(out_along, out_across) - radius
-            # The body's speed towards the box's nearest point (from the box to the body: out_*, world frame).
+            # The body's speed towards the box's nearest point (from the box to the body: out_*, world frame); with
+            # its centre inside the box (a walker that walked over it), towards the box's centre.
             away_x, away_y = out_along * c - out_across * s, out_along * s + out_across * c
             norm = math.hypot(away_x, away_y)
+            if norm <= 1e-9:
+                away_x, away_y = dx, dy
+                norm = math.hypot(dx, dy)
             closing = (-(velocity.x * away_x + velocity.y * away_y) / norm if norm > 1e-9
                        else math.hypot(velocity.x, velocity.y))
             with self.lock:
                 self.clearance[name] = min(self.clearance[name], gap)
-                if closing > CLOSING_SPEED:
-                    self.driving_clearance[name] = min(self.driving_clearance[name], gap)
+                if closing > CLOSING_SPEED and gap < self.driving_clearance[name]:
+                    self.driving_clearance[name] = gap
+                    self.driving_moment[name] = (
+                        f"at {rospy.get_time():.2f} s: body ({body.x:.2f}, {body.y:.2f}) moving ({velocity.x:.2f}, "
+                        f"{velocity.y:.2f}) m/s, closing at {closing:.2f} m/s on {name} at "
+                        f"({pose.position.x:.2f}, {pose.position.y:.2f})")
 
     def _amcl(self, msg):
         with self.lock:
@@ -193,7 +202,7 @@ class NavigationTest(unittest.TestCase):
                    f"body drove towards it")
             self.assertTrue(math.isfinite(gap), f"{name} was never seen in /gazebo/model_states")
             self.assertGreater(driving, 0.0, f"the body drove into {name} (clearance {driving:.3f} m while "
-                               f"closing on it)")
+                               f"closing on it, {self.rec.driving_moment[name]})")
         self.check_consumers()
 
     def check_consumers(self):
