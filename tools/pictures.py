@@ -12,6 +12,8 @@
 4. ``docs/manipulator.png`` (:func:`manipulator_picture`; also alone: ``tools/pictures.py manipulator``):
    diffbot_arm in worlds/pick_place.world holding the box above the pick table, the pose and the box placed
    as pick_place's lift step leaves them (no ROS, no display: PyBullet's TinyRenderer).
+5. ``docs/fleet.png`` (:func:`fleet_picture`; also alone: ``tools/pictures.py fleet``): a hundred
+   TurtleBot3-class robots and what their lasers hit.
 
 Every process is started in its own session and stopped by its process group; each run has its own master
 (``roslaunch -p PORT``). Prints one line per step, so a reader knows it is alive (about 1 min in all).
@@ -226,10 +228,86 @@ def manipulator_picture(path):
     xscreen.save_png(image, path, MAX_WIDTH)
 
 
+def fleet_picture(path, side=10, spacing=1.0):
+    """docs/fleet.png: ``side`` x ``side`` TurtleBot3-class robots (tests/data/multi_way's tb3like, as ``make
+    bench``'s fleet item loads them) on a grid ``spacing`` m apart, seen from above, with every robot's
+    360-beam scan (3.5 m, cast as the simulator casts it, ``World.ray_batch``) drawn where its rays hit: each
+    scan finds its neighbours (a line from the laser to each hit, the hit a red dot). No ROS, no display:
+    PyBullet's TinyRenderer."""
+    import numpy as np
+    import pybullet
+
+    sys.path.insert(0, os.path.join(ROOT, "tools"))
+    import bench_wave  # noqa: E402  (tools/: the fleet item's model)
+
+    from diffbot_sim.description import meshes
+    from diffbot_sim.description.model_files import package_path
+    from diffbot_sim.description.urdf_model import parse_urdf
+    from diffbot_sim.physics import World
+
+    model_path = bench_wave.fleet_model(True)
+    with open(model_path) as f:
+        text = f.read()
+    parsed = parse_urdf(text, model_path)
+    text, _ = meshes.prepare_meshes(text, model_path, os.path.dirname(model_path), meshes.default_cache_dir(),
+                                    package_path)
+    world = World(1.0 / 240.0)
+    width = height = 1400
+    try:
+        rng = np.random.default_rng(0)
+        robots = [world.load_robot(text, parsed, (spacing * (i % side), spacing * (i // side), 0.0),
+                                   yaw=float(rng.uniform(-np.pi, np.pi))) for i in range(side * side)]
+        for _ in range(240):  # settle on the wheels
+            world.step()
+        angles = np.linspace(0.0, 2.0 * np.pi, 360, endpoint=False)
+        starts, ends = [], []
+        for robot in robots:
+            (x, y, z), q = robot.link_pose("base_scan")
+            yaw = pybullet.getEulerFromQuaternion(q)[2]
+            for a in angles:
+                starts.append((x, y, z))
+                ends.append((x + 3.5 * np.cos(yaw + a), y + 3.5 * np.sin(yaw + a), z))
+        starts, ends = np.asarray(starts), np.asarray(ends)
+        fractions, bodies, _ = world.ray_batch(starts, ends)
+        hit = (bodies >= 0) & (fractions * 3.5 >= 0.12)  # the laser's <min>: its own body is not drawn
+        points = starts[hit] + (ends[hit] - starts[hit]) * fractions[hit, None]
+        centre = (spacing * (side - 1) / 2.0, spacing * (side - 1) / 2.0)
+        view = pybullet.computeViewMatrix((centre[0], centre[1], 14.0), (centre[0], centre[1], 0.0), (0, 1, 0))
+        projection = pybullet.computeProjectionMatrixFOV(42.0, 1.0, 1.0, 20.0)
+        _, _, rgba, _, _ = pybullet.getCameraImage(width, height, view, projection, shadow=0,
+                                                   lightDirection=(0.3, -0.5, 2.0),
+                                                   renderer=pybullet.ER_TINY_RENDERER, physicsClientId=world.client)
+    finally:
+        world.close()
+    image = np.array(np.reshape(np.asarray(rgba, dtype=np.uint8), (height, width, 4))[:, :, :3])
+    # Project with the camera's own matrices (column-major): each ray that hit, a thin line from its laser to
+    # the hit, and the hit a red dot on the robot it found.
+    v, p = np.asarray(view).reshape(4, 4).T, np.asarray(projection).reshape(4, 4).T
+
+    def pixels(xyz):
+        clip = (p @ v @ np.c_[xyz, np.ones(len(xyz))].T).T
+        ndc = clip[:, :2] / clip[:, 3:4]
+        return (np.clip(np.round((ndc[:, 0] + 1.0) / 2.0 * (width - 1)).astype(int), 0, width - 1),
+                np.clip(np.round((1.0 - ndc[:, 1]) / 2.0 * (height - 1)).astype(int), 0, height - 1))
+    along = np.linspace(0.0, 1.0, 60)[:, None, None]
+    u, w = pixels((starts[hit][None] + (points - starts[hit])[None] * along).reshape(-1, 3))
+    image[w, u] = (60, 170, 60)
+    u, w = pixels(points)
+    for du in (-1, 0, 1):
+        for dv in (-1, 0, 1):
+            image[np.clip(w + dv, 0, height - 1), np.clip(u + du, 0, width - 1)] = (220, 30, 30)
+    xscreen.save_png(image, path, MAX_WIDTH)
+    return len(robots), int(hit.sum())
+
+
 def main():
     if sys.argv[1:] == ["manipulator"]:
         manipulator_picture(os.path.join(DOCS, "manipulator.png"))
         say("docs/manipulator.png")
+        return 0
+    if sys.argv[1:] == ["fleet"]:
+        robots, hits = fleet_picture(os.path.join(DOCS, "fleet.png"))
+        say(f"docs/fleet.png: {robots} robots, {hits} laser hits drawn")
         return 0
     from diffbot_sim.nodes import plot_run
     from diffbot_sim.view import plot_data
@@ -271,6 +349,8 @@ def main():
             gui.stop()
     manipulator_picture(os.path.join(DOCS, "manipulator.png"))
     say("docs/manipulator.png")
+    robots, hits = fleet_picture(os.path.join(DOCS, "fleet.png"))
+    say(f"docs/fleet.png: {robots} robots, {hits} laser hits drawn")
     median = statistics.median(times)
     say(f"roslaunch -> first rviz frame with the robot, under Xvfb: median {median:.2f} s of {RUNS} "
         f"({', '.join(f'{t:.2f}' for t in times)})")
