@@ -160,10 +160,9 @@ class LoopModes(unittest.TestCase):
         cls.truth = Truth()
         wait_for(lambda: cls.follower.scan is not None, 30, "a first scan")
 
-    def run_once(self, max_update_rate, controller=None):
-        """Reset, set the pace (max_update_rate: 0 fast, 1/step real time), let ``controller`` (default: the
-        wall follower) drive for RUN s; the ground-truth path [(t, x, y)] and the wall time it took."""
-        controller = controller or self.follower
+    def run_once(self, max_update_rate, controller):
+        """Reset, set the pace (max_update_rate: 0 fast, 1/step real time), let ``controller`` drive for RUN s;
+        the ground-truth path [(t, x, y)] and the wall time it took."""
         controller.stop()
         self.physics(time_step=TIME_STEP, max_update_rate=max_update_rate, gravity=Vector3(0, 0, -9.8),
                      ode_config=ODEPhysics())
@@ -185,37 +184,32 @@ class LoopModes(unittest.TestCase):
         xb, yb = np.interp(t, b[:, 0], b[:, 1]), np.interp(t, b[:, 0], b[:, 2])
         return float(np.max(np.hypot(xa - xb, ya - yb)))
 
-    def test_fast_mode_follows_the_real_time_path(self):
-        reference, wall_rt = self.run_once(1.0 / TIME_STEP)
-        fast, wall_fast = self.run_once(0.0)
+    def judge(self, name, controller, tolerance):
+        """Run ``controller`` at real time, then fast; its fast path must stay within ``tolerance`` of the
+        real-time one (ground truth at the same sim times), and fast mode must be faster."""
+        reference, wall_rt = self.run_once(1.0 / TIME_STEP, controller)
+        fast, wall_fast = self.run_once(0.0, controller)
         travelled = float(np.sum(np.hypot(np.diff(reference[:, 1]), np.diff(reference[:, 2]))))
         d_fast = self.deviation(reference, fast)
-        print(f"FIGURE loop_modes: wall follower {RUN:g} s sim ({travelled:.2f} m): real time {wall_rt:.1f} s wall; "
+        print(f"FIGURE loop_modes: {name} {RUN:g} s sim ({travelled:.2f} m): real time {wall_rt:.1f} s wall; "
               f"fast {wall_fast:.1f} s wall ({RUN / wall_fast:.1f}x), path within {d_fast * 100:.1f} cm of the "
               "real-time one", flush=True)
-        self.assertGreater(travelled, 2.0, "the follower did not drive")
-        self.assertLess(d_fast, TOLERANCE, f"fast mode's path left the real-time path by {d_fast:.3f} m")
+        self.assertGreater(travelled, 2.0, f"the {name} did not drive")
+        self.assertLess(d_fast, tolerance, f"fast mode's path left the real-time path by {d_fast:.3f} m")
         self.assertLess(wall_fast, wall_rt, "fast mode was not faster than real time")
+
+    def test_fast_mode_follows_the_real_time_path(self):
+        self.judge("wall follower", self.follower, TOLERANCE)
 
     def test_a_follower_of_odometry_alone_follows_the_real_time_path(self):
         """A node that reads no sensor topic, only /odom, and publishes cmd_vel (a waypoint tour) is in the loop
         as a publisher of a command topic: its commands act at the same sim times in fast mode."""
         square = OdomFollowerProcess()
         try:
-            reference, wall_rt = self.run_once(1.0 / TIME_STEP, square)
-            fast, wall_fast = self.run_once(0.0, square)
+            self.judge("odometry follower", square, ODOM_TOLERANCE)
             square.alive()
         finally:
             square.close()
-        travelled = float(np.sum(np.hypot(np.diff(reference[:, 1]), np.diff(reference[:, 2]))))
-        d_fast = self.deviation(reference, fast)
-        print(f"FIGURE loop_modes: odometry follower {RUN:g} s sim ({travelled:.2f} m): real time {wall_rt:.1f} s "
-              f"wall; fast {wall_fast:.1f} s wall ({RUN / wall_fast:.1f}x), path within {d_fast * 100:.1f} cm of "
-              "the real-time one", flush=True)
-        self.assertGreater(travelled, 2.0, "the odometry follower did not drive")
-        self.assertLess(d_fast, ODOM_TOLERANCE, f"fast mode's path left the real-time path by {d_fast:.3f} m")
-        self.assertLess(wall_fast, wall_rt, "fast mode was not faster than real time")
-
 
 if __name__ == "__main__":
     rostest.rosrun("diffbot_sim", "loop_modes", LoopModes, sys.argv)
