@@ -66,7 +66,7 @@ def settle(read, tolerance, timeout=30.0, interval=0.3):
         done = all(abs(a - b) < tolerance for a, b in zip(now, last))
         last = now
         return done
-    wait_for(still, timeout, "the joints to come to rest")
+    wait_for(still, timeout, "the readings to come to rest")
     return last
 
 
@@ -119,7 +119,9 @@ class ArmTraits(unittest.TestCase):
         base = self.truth.link(f"{ns}::base_link")  # where the vise is now (pushes may have moved it)
         local = ((0.0, -0.05 + BOX[1] / 2 + 0.001, 0.05 + BOX[2] / 2 + 0.001), (0.0, 0.0, 0.0, 1.0))
         spawn_box(name, BOX, 0.1, compose(base, local)[0])
-        sim_sleep(0.3)
+        # at rest before the jaws close on it (it drops the 1 mm and settles against the jaw): a box still
+        # moving is squeezed tilted
+        settle(lambda: list(self.truth.object(name)[0]), 0.0001, interval=0.2)
 
     def assert_clamped(self, ns, name, when):
         """The box, in the vise's base frame, lies between the jaws' faces (its 3 cm along x within the jaws'
