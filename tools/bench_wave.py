@@ -234,17 +234,24 @@ def fleet_trial(count, seconds, model, rsp, laser):
     return result
 
 
-def bare_fleet(count, seconds, model):
-    """``count`` of the same robots stepped by PyBullet alone (same step), wheels turning: their RTF."""
+def loadable(model):
+    """``(urdf_text, parsed)`` of the model file as the simulator loads it (package:// meshes resolved and
+    cached), for ``World.load_robot`` without ROS."""
     sys.path.insert(0, os.path.join(ROOT, "src"))
     from diffbot_sim.description import meshes
     from diffbot_sim.description.model_files import package_path
     from diffbot_sim.description.urdf_model import parse_urdf
-    from diffbot_sim.physics import World
     with open(model) as f:
         text = f.read()
-    parsed = parse_urdf(text, model)  # the meshes as the simulator prepares them (package:// resolved, cached)
+    parsed = parse_urdf(text, model)
     text, _ = meshes.prepare_meshes(text, model, os.path.dirname(model), meshes.default_cache_dir(), package_path)
+    return text, parsed
+
+
+def bare_fleet(count, seconds, model):
+    """``count`` of the same robots stepped by PyBullet alone (same step), wheels turning: their RTF."""
+    from diffbot_sim.physics import World
+    text, parsed = loadable(model)
     world = World(STEP)
     try:
         for i in range(count):

@@ -240,17 +240,9 @@ def fleet_picture(path, side=10, spacing=1.0):
     sys.path.insert(0, os.path.join(ROOT, "tools"))
     import bench_wave  # noqa: E402  (tools/: the fleet item's model)
 
-    from diffbot_sim.description import meshes
-    from diffbot_sim.description.model_files import package_path
-    from diffbot_sim.description.urdf_model import parse_urdf
     from diffbot_sim.physics import World
 
-    model_path = bench_wave.fleet_model(True)
-    with open(model_path) as f:
-        text = f.read()
-    parsed = parse_urdf(text, model_path)
-    text, _ = meshes.prepare_meshes(text, model_path, os.path.dirname(model_path), meshes.default_cache_dir(),
-                                    package_path)
+    text, parsed = bench_wave.loadable(bench_wave.fleet_model(True))
     world = World(1.0 / 240.0)
     width = height = 1400
     try:

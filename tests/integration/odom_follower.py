@@ -20,13 +20,11 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from std_msgs.msg import Bool
 
+from diffbot_sim.transforms import yaw_from_quaternion
+
 SIDE = 1.2  # m
 SPEED = 0.25  # m/s
 REACHED = 0.08  # m: a corner this close is passed
-
-
-def yaw_of(q):
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
 class Follower:
@@ -42,9 +40,9 @@ class Follower:
         self.timer = rospy.Timer(rospy.Duration(0.1), self._tick, reset=True)  # survives reset_simulation
 
     def _odom(self, msg):
-        p = msg.pose.pose
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
         with self.lock:
-            self.pose = (p.position.x, p.position.y, yaw_of(p.orientation))
+            self.pose = (p.x, p.y, yaw_from_quaternion(q.x, q.y, q.z, q.w))
 
     def _active(self, msg):
         with self.lock:

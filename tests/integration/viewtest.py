@@ -26,8 +26,8 @@ from diffbot_sim.view import xscreen
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
 ROBOT = os.path.join(ROOT, "tests", "data", "robots", "view_robot.urdf")
 WORLD = os.path.join(ROOT, "tests", "data", "worlds", "laser_room.world")
-#: roslaunch's colours (ESC [ ... m) and terminal-title sequences (ESC ] ... BEL) in its log
-TERMINAL_ESCAPE = re.compile(r"\x1b\[[0-9;]*m|\x1b\][^\x07]*\x07")
+#: roslaunch's colours (ESC [ ... m), terminal-title sequences (ESC ] ... BEL) and "=====" rules in its log
+TERMINAL_ESCAPE = re.compile(r"\x1b\[[0-9;]*m|\x1b\][^\x07]*\x07|={5,}")
 
 
 class _SendFilePathRequest(genpy.Message):
@@ -128,7 +128,7 @@ class View:
         lines = self.log_lines()
         if not any("rviz version" in line for line in lines):
             return None
-        died = [re.sub(r"={5,}", "", line).strip() for line in lines if "has died" in line]
+        died = [line.strip() for line in lines if "has died" in line]
         if any("[bullet_sim" in line for line in died):
             return None
         if any("[rviz" in line for line in died):
@@ -158,7 +158,7 @@ class View:
     def deaths(self):
         """roslaunch's lines naming each node that died (exit code, command), and the lines of errors the
         nodes printed: what the failure line of a CI run, which keeps only the gist, must carry first."""
-        lines = [re.sub(r"={5,}", "", line).strip() for line in self.log_lines()]
+        lines = [line.strip() for line in self.log_lines()]
         wanted = ("has died", "Error", "error:", "Traceback", "Segmentation", "Aborted", "terminate called")
         harmless = ("media_export", "librospack")  # rviz asks rospack for a package Debian does not ship
         found = [line[:300] for line in lines
@@ -169,7 +169,7 @@ class View:
         return "\n".join(self.log_lines()[-lines:])
 
     def log_lines(self):
-        """The launch log's lines, without roslaunch's terminal colour and title escapes."""
+        """The launch log's lines, without roslaunch's terminal escapes and rules (TERMINAL_ESCAPE)."""
         self.log_file.flush()
         with open(self.log_path, errors="replace") as f:
             return [TERMINAL_ESCAPE.sub("", line.rstrip("\n")) for line in f]
