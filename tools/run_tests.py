@@ -225,6 +225,7 @@ def run_nav(args):
         return 1
     # The Gazebo user's own packages (fakebot_gazebo, _slam, _navigation) that nav_gazebo_way_* launch.
     add_package_path(NAV_FIXTURES)
+    add_package_path(MULTI_FIXTURES)  # tb3like_gazebo, _slam, _navigation: the nav_multi_* suites
     suites = sorted(glob.glob(os.path.join(ROOT, "tests", "integration", "nav_*.test")))
     if args.only:
         suites = [t for t in suites if args.only in os.path.basename(t)]

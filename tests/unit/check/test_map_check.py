@@ -70,3 +70,45 @@ def test_a_missing_obstacle_is_named(sections):
 def test_free_cells_inside_a_wall_are_a_hole(sections):
     report = map_check.judge(true_map(hole=True), sections)
     assert report.free_inside > 0 and any("inside a solid" in f for f in report.failures)
+
+
+def test_true_map_marks_the_solids_and_their_outlines_occupied_and_the_rest_free(sections):
+    grid = map_check.true_map(sections, -2.0, -1.5, RES, 80, 60)
+    occupied = grid.centres(*np.nonzero(grid.data == 100))
+    assert set(np.unique(grid.data)) == {0, 100}
+    # Every occupied cell is inside a solid or within half a cell's diagonal of a surface; every solid's centre
+    # and a point on the box's face are occupied; the open floor between them is free.
+    all_segments = np.vstack([s for _, s in sections])
+    rows, cols = np.nonzero(grid.data == 100)
+    on_surface = map_check.distances(occupied, all_segments) <= RES * np.sqrt(0.5) + 1e-9
+    assert (on_surface | map_check.solids_on(grid, sections)[rows, cols]).all()
+
+    def at(x, y):
+        return grid.data[int((y + 1.5) / RES), int((x + 2.0) / RES)]
+    assert at(1.0, 0.0) == 100 and at(-1.0, 0.5) == 100 and at(0.52, 0.0) == 100
+    assert at(0.0, 0.0) == 0 and at(1.0, 0.3) == 0 and at(-1.0, 0.9) == 0
+
+
+def test_a_fleet_robot_s_partial_map_passes_without_the_obstacles_it_never_saw(sections):
+    report = map_check.judge(true_map(drop_cylinder=True), sections, every_obstacle=True)
+    assert not report.passed
+    # Unseen: the cylinder's cells left unknown (no free cell next to them).
+    grid = true_map(drop_cylinder=True)
+    rows, cols = np.indices(grid.data.shape)
+    xy = grid.centres(rows.ravel(), cols.ravel())
+    grid.data[(np.hypot(xy[:, 0] + 1.0, xy[:, 1] - 0.5) < 0.5).reshape(grid.data.shape)] = -1
+    assert not map_check.judge(grid, sections).passed
+    assert map_check.judge(grid, sections, every_obstacle=False).passed
+
+
+def test_enough_mapped_cells_pass_an_obstacle_seen_mostly_at_grazing_angles(sections):
+    # The box mapped on its east end only (the rest of its outline free): under half its seen outline.
+    grid = true_map()
+    rows, cols = np.indices(grid.data.shape)
+    x = grid.centres(rows.ravel(), cols.ravel())[:, 0].reshape(grid.data.shape)
+    box_west = (x < 1.3) & (x > 0.4) & (grid.data == 100)
+    grid.data[box_west] = 0
+    strict = map_check.judge(grid, sections)
+    assert any(f.startswith("the obstacle at (1.00, 0.00)") for f in strict.failures), strict.failures
+    assert not map_check.judge(grid, sections, enough_mapped=1000).passed
+    assert map_check.judge(grid, sections, enough_mapped=10).passed
