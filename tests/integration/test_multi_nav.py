@@ -21,7 +21,8 @@ from the simulator and ``tb3_N/map -> tb3_N/odom`` from that robot's gmapping, o
 amcl.
 
 Argument: slam or goals. Parameters: ~robots ([{name, goal: [x, y, yaw]}]; a goal only for goals), ~world and
-~laser_height (slam), ~xy_tolerance (0.25), ~goal_timeout (sim s, 240), ~body_outline, ~timeout (wall s, 900). FIGURE lines: maps, goals, clearances, sim/wall time, RTF.
+~laser_height (slam), ~xy_tolerance (0.25), ~goal_timeout (sim s, 240), ~body_outline, ~timeout (wall s, 900).
+FIGURE lines: maps, goals, clearances, sim/wall time, RTF.
 """
 import math
 import sys
