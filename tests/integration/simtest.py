@@ -109,6 +109,30 @@ class Truth:
         return body
 
 
+class TfEdges:
+    """Which nodes published each TF edge (parent, child) on /tf, and with ``static`` on /tf_static as well
+    (callbacks only store): a consumer of the tree needs each edge from one node."""
+
+    def __init__(self, static=False):
+        self.lock = threading.Lock()
+        self._publishers = {}  # (parent, child) -> set of caller ids
+        rospy.Subscriber("/tf", TFMessage, self._keep, queue_size=1000)
+        if static:
+            rospy.Subscriber("/tf_static", TFMessage, self._keep, queue_size=100)
+
+    def _keep(self, msg):
+        caller = msg._connection_header.get("callerid", "?")
+        with self.lock:
+            for t in msg.transforms:
+                self._publishers.setdefault((t.header.frame_id.lstrip("/"), t.child_frame_id.lstrip("/")),
+                                            set()).add(caller)
+
+    def edges(self):
+        """{(parent, child): set of caller ids} so far (a copy)."""
+        with self.lock:
+            return {edge: set(who) for edge, who in self._publishers.items()}
+
+
 def assert_upright(pose, height, what):
     """A geometry_msgs/Pose of a driven robot (from /gazebo/get_model_state) rests at ``height`` and upright."""
     from diffbot_sim.check import drive_check

@@ -38,11 +38,10 @@ from actionlib_msgs.msg import GoalStatus
 from gazebo_msgs.msg import ModelStates
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from nav_msgs.msg import OccupancyGrid
-from tf2_msgs.msg import TFMessage
 
 from diffbot_sim.check import map_check
 from diffbot_sim.world.loading import load_world
-from simtest import action_done, figure, wait_for, yaw_of
+from simtest import TfEdges, action_done, figure, wait_for, yaw_of
 
 #: tb3like's footprint as seen from above (its collision shapes: the 0.138 m box about (-0.032, 0) and the two
 #: wheels, r 0.033 m and 0.018 m wide at y +-0.080), as the convex outline [x, y] in base_footprint.
@@ -88,18 +87,16 @@ ENOUGH_MAPPED = 10
 
 class Fleet:
     """What the robots do, by ground truth and TF (callbacks only store): each robot's latest pose, the
-    smallest gap between any two robots' bounding circles and when, and which node published each TF edge."""
+    smallest gap between any two robots' outlines and when, and which node published each TF edge."""
 
     def __init__(self, names):
         self.names = list(names)
         self.lock = threading.Lock()
         self.poses = {}  # name -> (x, y, yaw, sim t)
         self.gap, self.gap_moment = math.inf, ""
-        self.tf_publishers = {}  # (parent, child) -> set of caller ids
         self.outline = np.array(rospy.get_param("~body_outline", TB3LIKE_OUTLINE), dtype=float)
         rospy.Subscriber("/gazebo/model_states", ModelStates, self._models, queue_size=1)
-        rospy.Subscriber("/tf", TFMessage, self._tf, queue_size=1000)
-        rospy.Subscriber("/tf_static", TFMessage, self._tf, queue_size=100)
+        self.tf = TfEdges(static=True)  # robot_state_publisher's fixed joints are on /tf_static
 
     def _models(self, msg):
         now = rospy.get_time()
@@ -124,13 +121,6 @@ class Fleet:
                         self.gap_moment = (f"{a} at ({pa[0]:.2f}, {pa[1]:.2f}, {pa[2]:.2f} rad) and {b} at "
                                            f"({pb[0]:.2f}, {pb[1]:.2f}, {pb[2]:.2f} rad), sim t {now:.1f} s")
 
-    def _tf(self, msg):
-        caller = msg._connection_header.get("callerid", "?")
-        with self.lock:
-            for t in msg.transforms:
-                self.tf_publishers.setdefault((t.header.frame_id.lstrip("/"), t.child_frame_id.lstrip("/")),
-                                              set()).add(caller)
-
     def pose(self, name):
         with self.lock:
             return self.poses.get(name)
@@ -140,8 +130,7 @@ class Fleet:
             return self.gap, self.gap_moment
 
     def edges(self):
-        with self.lock:
-            return {edge: set(who) for edge, who in self.tf_publishers.items()}
+        return self.tf.edges()
 
 
 class MultiNavTest(unittest.TestCase):

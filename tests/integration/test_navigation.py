@@ -27,10 +27,9 @@ from geometry_msgs.msg import PoseWithCovarianceStamped
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from rosgraph_msgs.msg import Clock, Log
 from sensor_msgs.msg import LaserScan
-from tf2_msgs.msg import TFMessage
 
 from diffbot_sim.check.drive_check import wrap
-from simtest import Truth, figure, wait_for
+from simtest import TfEdges, Truth, figure, wait_for
 
 NODES = ("/amcl", "/move_base")
 CLOSING_SPEED = 0.02  # m/s: the body counts as driving towards a model of ~avoid above this
@@ -42,9 +41,8 @@ class Recorder:
     def __init__(self):
         self.lock = threading.Lock()
         self.clock, self.scans, self.logs = [], [], []
-        self.tf_publishers = {}  # (parent, child) -> set of caller ids
+        self.tf = TfEdges()
         rospy.Subscriber("/clock", Clock, self._clock, queue_size=1000)
-        rospy.Subscriber("/tf", TFMessage, self._tf, queue_size=1000)
         rospy.Subscriber("/scan", LaserScan, self._scan, queue_size=10)
         rospy.Subscriber("/rosout", Log, self._log, queue_size=1000)  # rostest starts no rosout node: no /rosout_agg
         self.amcl = None
@@ -126,13 +124,6 @@ class Recorder:
         with self.lock:
             self.clock.append(msg.clock.to_sec())
 
-    def _tf(self, msg):
-        caller = msg._connection_header.get("callerid", "?")
-        with self.lock:
-            for t in msg.transforms:
-                self.tf_publishers.setdefault((t.header.frame_id.lstrip("/"), t.child_frame_id.lstrip("/")),
-                                              set()).add(caller)
-
     def _scan(self, msg):
         with self.lock:
             self.scans.append(msg)
@@ -209,9 +200,9 @@ class NavigationTest(unittest.TestCase):
         rec = self.rec
         with rec.lock:
             clock, scans, logs = list(rec.clock), list(rec.scans), list(rec.logs)
-            publishers = {edge: set(who) for edge, who in rec.tf_publishers.items()}
         self.assertGreater(len(clock), 100)
         self.assertTrue(all(b > a for a, b in zip(clock, clock[1:])), "/clock must strictly increase")
+        publishers = rec.tf.edges()
         twice = {edge: who for edge, who in publishers.items() if len(who) > 1}
         self.assertEqual(twice, {}, "TF edges published by more than one node")
         children = {}
