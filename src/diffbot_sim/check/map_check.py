@@ -236,15 +236,13 @@ class MapReport:
 
 
 def judge(grid, sections, near=NEAR, deep=DEEP, coverage=COVERAGE, min_near_fraction=0.9, every_obstacle=True,
-          enough_mapped=None, allowed_free_inside=0):
+          enough_mapped=None):
     """Compare ``grid`` (a :class:`Grid`) with the true ``sections`` (:func:`world_section`).
 
     For a robot of a fleet, which maps only its part of the world: with ``every_obstacle`` false an obstacle
     it never saw is no failure, and with ``enough_mapped`` (cells) an obstacle with that many boundary cells
     mapped passes even below ``coverage`` (a face it saw only at a grazing angle from afar counts as seen: a free
-    cell next to it, yet no beam ended on it). ``allowed_free_inside`` free cells deeper than ``deep`` inside a
-    solid are tolerated (a scan registered a few cm off by a starved gmapping carves one; a beam through a wall
-    carves a line of them)."""
+    cell next to it, yet no beam ended on it)."""
     all_segments = np.vstack([s for _, s in sections]) if sections else np.zeros((0, 4))
     rows, cols = np.nonzero(grid.occupied)
     occupied_xy = grid.centres(rows, cols)
@@ -265,7 +263,7 @@ def judge(grid, sections, near=NEAR, deep=DEEP, coverage=COVERAGE, min_near_frac
         depth = distances(grid.centres(r, c), all_segments)
         deep_xy = grid.centres(r, c)[depth > deep]
         report.free_inside = len(deep_xy)
-        if report.free_inside > allowed_free_inside:
+        if report.free_inside:
             where = ", ".join(f"({x:.2f}, {y:.2f})" for x, y in deep_xy[:5])
             report.failures.append(f"{report.free_inside} free map cells lie more than {deep} m inside a solid: "
                                    f"{where}{' ...' if report.free_inside > 5 else ''}")
