@@ -8,7 +8,8 @@ steering by TF ``tb3_N/map -> tb3_N/base_footprint``). Once every tour is throug
 judged against the world's true geometry (diffbot_sim.check.map_check) in world coordinates: with odometrySource
 world a robot's odom frame is the world's, and gmapping's map frame starts on it. A robot maps only its part of
 the house: of the obstacles, those it saw must be mapped, on half their seen outline or on ENOUGH_MAPPED cells;
-no free cell more than HOLE_DEPTH inside a solid.
+no free cell more than HOLE_DEPTH inside a solid;
+NEAR_SHARE of its occupied cells on true surfaces (the other robots are in its map, not in the world file).
 
 ``goals``: amcl and move_base run in each robot's namespace on the shared ``/map`` (tb3like_navigation's
 multi_tb3like_navigation.launch); every robot gets its goal at the same moment (paths that cross), and each must
@@ -90,6 +91,10 @@ ENOUGH_MAPPED = 10
 #: maps), while 272,000 rays cast about that kitchen at the laser's height, 200,000 of them at the counter from
 #: where the robot turns, crossed no solid: gmapping's registration, not the sensor.
 HOLE_DEPTH = map_check.NEAR
+#: Of one robot's occupied cells, the share that must lie on a true surface: the other robots are in its scans
+#: and its map (their laser housings, and the trail gmapping leaves of a robot that moved) but not in the world
+#: file; 91.9-97.9 % measured in 18 maps (the single-robot suites ask 90 % and see 99-100 %).
+NEAR_SHARE = 0.85
 
 
 class Fleet:
@@ -205,8 +210,8 @@ class MultiSlamTest(MultiNavTest):
             # put before the already prefixed frame once more (its TF is tb3_N/map -> tb3_N/odom all the same).
             self.assertIn(msg.header.frame_id.lstrip("/"), (f"{name}/map", f"{name}/{name}/map"))
             grid = map_check.Grid.from_message(msg)
-            report = map_check.judge(grid, sections, deep=HOLE_DEPTH, every_obstacle=False,
-                                     enough_mapped=ENOUGH_MAPPED)
+            report = map_check.judge(grid, sections, deep=HOLE_DEPTH, min_near_fraction=NEAR_SHARE,
+                                     every_obstacle=False, enough_mapped=ENOUGH_MAPPED)
             seen = [o for o in report.obstacles if o.seen]
             figure(f"{name}'s map: {report.occupied} occupied cells, {report.near_fraction:.1%} within "
                    f"{map_check.NEAR} m of a true surface, median error {report.median_error * 100:.1f} cm, "
