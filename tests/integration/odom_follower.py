@@ -5,10 +5,10 @@
 
 It subscribes ``/odom`` only (no sensor topic) and publishes ``/cmd_vel`` from a rospy.Timer of 0.1 s of sim
 time: the shape of a waypoint tour or a path follower. While ``/odom_follower/active`` (std_msgs/Bool) is true it
-drives a 1.2 m square from where odometry says it is when activated, turning towards each corner in turn, and
-burns ~15 ms of CPU per tick as a real controller's computation would; when it turns false it publishes a zero
-Twist once. A jump back of sim time (reset_simulation) starts the square again. Prints ``READY`` when its
-/cmd_vel publisher is connected to the simulator.
+drives a 1.2 m square from where the first odometry after the activation says it is, turning towards each
+corner in turn, and burns ~15 ms of CPU per tick as a real controller's computation would; when it turns false
+it publishes a zero Twist once. A jump back of sim time (reset_simulation) starts the square again. Prints
+``READY`` when its /cmd_vel publisher is connected to the simulator.
 """
 import math
 import sys
@@ -40,21 +40,25 @@ class Follower:
         self.timer = rospy.Timer(rospy.Duration(0.1), self._tick, reset=True)  # survives reset_simulation
 
     def _odom(self, msg):
+        if msg.header.stamp.to_sec() > rospy.get_time() + 0.05:
+            return  # stamped ahead of the clock: sent before a reset_simulation, a pose of the last run
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
         with self.lock:
             self.pose = (p.x, p.y, yaw_from_quaternion(q.x, q.y, q.z, q.w))
 
     def _active(self, msg):
         with self.lock:
-            self.active, self.corners = msg.data, None
+            # The square starts from the first odometry after this: the pose kept from before a reset is the
+            # last run's end (a square built on it once took the fast path 1.76 m off the real-time one).
+            self.active, self.corners, self.pose = msg.data, None, None
         if not msg.data:
             self.cmd.publish(Twist())
 
     def _tick(self, _event):
         now = rospy.get_time()
         with self.lock:
-            if now < self.last_time:  # reset_simulation: start the square again
-                self.corners = None
+            if now < self.last_time:  # reset_simulation: start the square again, from odometry after it
+                self.corners, self.pose = None, None
             self.last_time = now
             if not self.active or self.pose is None:
                 return
