@@ -618,9 +618,10 @@ def bench_worlds(runs, seconds):
                                       lambda: shutil.rmtree(cache, ignore_errors=True))
     # The furnished house of meshes (tests/data/multi_way: 30 000 triangles in COLLADA, STL and OBJ, found as
     # model://house through tb3like_gazebo's gazebo_model_path export), with the mesh cache warm: one run fills it.
-    multi = os.path.join(ROOT, "tests", "data", "multi_way")
-    os.environ["ROS_PACKAGE_PATH"] = os.pathsep.join([os.environ.get("ROS_PACKAGE_PATH", ""), multi])
-    house = (f"world:={os.path.join(multi, 'tb3like_gazebo', 'worlds', 'house.world')}", "robot_state_publisher:=false")
+    from run_tests import MULTI_FIXTURES, add_package_path  # tools/: the fixture packages the test suites use
+    add_package_path(MULTI_FIXTURES)
+    house = (f"world:={os.path.join(MULTI_FIXTURES, 'tb3like_gazebo', 'worlds', 'house.world')}",
+             "robot_state_publisher:=false")
     bench_startup(1, house, home)
     out["house_world"] = bench_startup(runs, house, home)
     out["empty_world"] = bench_startup(runs, ("robot_state_publisher:=false",), home)

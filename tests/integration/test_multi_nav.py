@@ -43,7 +43,7 @@ from nav_msgs.msg import OccupancyGrid
 
 from diffbot_sim.check import map_check
 from diffbot_sim.world.loading import load_world
-from simtest import TfEdges, action_done, figure, wait_for, yaw_of
+from simtest import Latest, TfEdges, action_done, figure, wait_for, yaw_of
 
 #: tb3like's footprint as seen from above (its collision shapes: the 0.138 m box about (-0.032, 0) and the two
 #: wheels, r 0.033 m and 0.018 m wide at y +-0.080), as the convex outline [x, y] in base_footprint.
@@ -51,34 +51,25 @@ TB3LIKE_OUTLINE = [[-0.101, -0.069], [-0.033, -0.089], [0.033, -0.089], [0.037, 
                    [0.033, 0.089], [-0.033, 0.089], [-0.101, 0.069]]
 
 
-def _point_segment(p, a, b):
-    ab = b - a
-    t = min(max(float(np.dot(p - a, ab) / max(np.dot(ab, ab), 1e-18)), 0.0), 1.0)
-    return float(np.linalg.norm(p - (a + t * ab)))
-
-
-def _inside_convex(p, poly):
-    cross = [(b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
-             for a, b in zip(poly, np.roll(poly, -1, axis=0))]
-    return all(c >= 0 for c in cross) or all(c <= 0 for c in cross)
+def _edges(outline):
+    """The closed outline's edges as map_check segments: (N, 4) [x1, y1, x2, y2]."""
+    return np.hstack([outline, np.roll(outline, -1, axis=0)])
 
 
 def outline_gap(a, b):
     """The distance [m] between two convex outlines ((N, 2) corners in order); 0 when they touch or overlap."""
-    if any(_inside_convex(p, b) for p in a) or any(_inside_convex(p, a) for p in b):
+    edges_a, edges_b = _edges(a), _edges(b)
+    if map_check.inside(a, edges_b).any() or map_check.inside(b, edges_a).any():
         return 0.0
-    edges_a, edges_b = list(zip(a, np.roll(a, -1, axis=0))), list(zip(b, np.roll(b, -1, axis=0)))
-    for p, q in edges_a:  # crossing edges (no corner inside the other)
-        for r, t in edges_b:
+    for p, q in zip(a, np.roll(a, -1, axis=0)):  # crossing edges (no corner inside the other)
+        for r, t in zip(b, np.roll(b, -1, axis=0)):
             d1 = (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
             d2 = (q[0] - p[0]) * (t[1] - p[1]) - (q[1] - p[1]) * (t[0] - p[0])
             d3 = (t[0] - r[0]) * (p[1] - r[1]) - (t[1] - r[1]) * (p[0] - r[0])
             d4 = (t[0] - r[0]) * (q[1] - r[1]) - (t[1] - r[1]) * (q[0] - r[0])
             if d1 * d2 < 0 and d3 * d4 < 0:
                 return 0.0
-    return min(min(_point_segment(p, r, t) for p in a for r, t in edges_b),
-               min(_point_segment(p, r, t) for p in b for r, t in edges_a))
-
+    return float(min(map_check.distances(a, edges_b).min(), map_check.distances(b, edges_a).min()))
 
 
 #: Boundary cells (half a metre of outline) that make an obstacle mapped in a robot's partial map, whatever share
@@ -141,9 +132,6 @@ class Fleet:
         with self.lock:
             return self.gap, self.gap_moment
 
-    def edges(self):
-        return self.tf.edges()
-
 
 class MultiNavTest(unittest.TestCase):
     @classmethod
@@ -157,7 +145,7 @@ class MultiNavTest(unittest.TestCase):
     def check_tf(self, map_parent):
         """Each robot's chain under its prefix, each edge from one node (``map_parent(name)``: the frame amcl or
         gmapping hangs the robot's odom frame on)."""
-        edges = self.fleet.edges()
+        edges = self.fleet.tf.edges()
         twice = {edge: who for edge, who in edges.items() if len(who) > 1}
         self.assertEqual(twice, {}, "TF edges published by more than one node")
         for name in self.names:
@@ -175,18 +163,10 @@ class MultiNavTest(unittest.TestCase):
 
 
 class MultiSlamTest(MultiNavTest):
-    maps = {}
-
     @classmethod
     def setUpClass(cls):
         super().setUpClass()
-        for name in cls.names:
-            rospy.Subscriber(f"/{name}/map", OccupancyGrid, cls._keep, callback_args=name, queue_size=1)
-
-    @classmethod
-    def _keep(cls, msg, name):
-        with cls.fleet.lock:
-            cls.maps[name] = msg
+        cls.maps = {name: Latest(f"/{name}/map", OccupancyGrid) for name in cls.names}
 
     def test_each_robot_maps_its_part_of_the_world(self):
         wall0 = time.monotonic()
@@ -201,11 +181,8 @@ class MultiSlamTest(MultiNavTest):
         sections = map_check.world_section(world, float(rospy.get_param("~laser_height")))
         failures = []
         for name in self.names:
-            def fresh():
-                with self.fleet.lock:
-                    msg = self.maps.get(name)
-                return msg is not None and msg.header.stamp.to_sec() > done_at and msg
-            msg = wait_for(fresh, 120.0, f"a /{name}/map published after the tours")
+            msg = wait_for(lambda: (m := self.maps[name].get()) is not None and m.header.stamp.to_sec() > done_at
+                           and m, 120.0, f"a /{name}/map published after the tours")
             # gmapping stamps its /map with tf_.resolve(map_frame): the tf_prefix it finds from its namespace is
             # put before the already prefixed frame once more (its TF is tb3_N/map -> tb3_N/odom all the same).
             self.assertIn(msg.header.frame_id.lstrip("/"), (f"{name}/map", f"{name}/{name}/map"))
@@ -276,5 +253,5 @@ class MultiGoalsTest(MultiNavTest):
 if __name__ == "__main__":
     # The kind is the test's argument (args="slam" or "goals" in the .test file): it picks the test class
     # before the node exists to read a parameter.
-    kind = "slam" if "slam" in sys.argv[1:] else "goals"
-    rostest.rosrun("diffbot_sim", "test_multi_nav", MultiSlamTest if kind == "slam" else MultiGoalsTest, sys.argv)
+    rostest.rosrun("diffbot_sim", "test_multi_nav", MultiSlamTest if "slam" in sys.argv[1:] else MultiGoalsTest,
+                   sys.argv)

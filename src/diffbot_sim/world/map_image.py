@@ -411,15 +411,22 @@ def synthetic_map(path, size=4000, seed=0, room=200, wall=10, door=40, noise=0.0
             occupied[at:at + wall, mid - door // 2:mid + door // 2] = False
             occupied[mid - door // 2:mid + door // 2, at:at + wall] = False
     occupied |= rng.random((size, size)) < noise
-    pixels = np.where(occupied, 0, 254).astype(np.uint8)
+    half = size * resolution / 2.0
+    return write_map(path, occupied, resolution, (-half, -half),
+                     f"synthetic_map(size={size}, seed={seed}, room={room}, wall={wall}, door={door}, noise={noise})")
+
+
+def write_map(path, occupied, resolution, origin, comment):
+    """Write a map_server map as map_saver does: ``path`` (.yaml) and its trinary .pgm beside it, 0 where
+    ``occupied`` (a (rows, cols) bool array, row 0 the image's top), 254 elsewhere; ``origin`` (x, y) [m] of the
+    image's bottom-left corner; ``comment`` in both files' headers. Returns ``path``."""
+    rows, cols = occupied.shape
     image = os.path.splitext(path)[0] + ".pgm"
     with open(image, "wb") as stream:
-        stream.write(b"P5\n# diffbot_sim.world.map_image.synthetic_map\n%d %d\n255\n" % (size, size))
-        stream.write(pixels.tobytes())
-    half = size * resolution / 2.0
+        stream.write(b"P5\n# %s\n%d %d\n255\n" % (comment.encode(), cols, rows))
+        stream.write(np.where(occupied, 0, 254).astype(np.uint8).tobytes())
     with open(path, "w", encoding="utf-8") as stream:
-        stream.write(f"# synthetic_map(size={size}, seed={seed}, room={room}, wall={wall}, door={door}, "
-                     f"noise={noise})\n")
+        stream.write(f"# {comment}\n")
         stream.write(f"image: {os.path.basename(image)}\nresolution: {resolution}\n"
-                     f"origin: [{-half}, {-half}, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+                     f"origin: [{origin[0]}, {origin[1]}, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
     return path

@@ -14,6 +14,7 @@ sys.path.insert(0, os.path.join(HERE, "..", "..", "..", "src"))
 os.environ["ROS_PACKAGE_PATH"] = os.pathsep.join([HERE, os.environ.get("ROS_PACKAGE_PATH", "")])
 
 from diffbot_sim.check import map_check  # noqa: E402
+from diffbot_sim.world import map_image  # noqa: E402
 from diffbot_sim.world.loading import load_world  # noqa: E402
 
 LASER_HEIGHT = 0.181  # m: tb3like's base_scan above the ground
@@ -25,15 +26,9 @@ OUT = os.path.join(HERE, "tb3like_navigation", "maps")
 def main():
     world = load_world(os.path.join(HERE, "tb3like_gazebo", "worlds", "house.world"), 1.0)
     grid = map_check.true_map(map_check.world_section(world, LASER_HEIGHT), X0, Y0, RESOLUTION, WIDTH, HEIGHT)
-    # map_saver's trinary image: 0 occupied, 254 free, rows from the top (the grid's last row first).
-    pixels = bytes(0 if v == 100 else 254 for row in grid.data[::-1] for v in row)
-    with open(os.path.join(OUT, "house.pgm"), "wb") as pgm:
-        pgm.write(b"P5\n# made by tests/data/multi_way/make_map.py from house.world\n%d %d\n255\n" % (WIDTH, HEIGHT))
-        pgm.write(pixels)
-    with open(os.path.join(OUT, "house.yaml"), "w") as meta:
-        meta.write(f"image: house.pgm\nresolution: {RESOLUTION:.6f}\norigin: [{X0}, {Y0}, 0.000000]\nnegate: 0\n"
-                   f"occupied_thresh: 0.65\nfree_thresh: 0.196\n\n")
-
+    # the image's top row is the grid's last
+    map_image.write_map(os.path.join(OUT, "house.yaml"), grid.data[::-1] == 100, RESOLUTION, (X0, Y0),
+                        "made by tests/data/multi_way/make_map.py from house.world")
 
 if __name__ == "__main__":
     main()
