@@ -204,6 +204,13 @@ def probe_rtf(options):
     for pub in pubs:  # drive in circles: wheels, casters and contacts all busy
         pub.publish(circle)
     time.sleep(options.get("warmup", 3.0))
+    if options.get("leave"):
+        # Fast mode waits after each /clock tick for the nodes that publish its commands (~wait_for_nodes):
+        # with its publishers kept, this probe would be measured, not the simulator. The simulator holds the
+        # last command (cmd_vel_timeout 0, as Gazebo), so the robot keeps driving its circle.
+        for pub in pubs:
+            pub.unregister()
+        time.sleep(1.0)
     pid = _sim_pid()
     cpu0, n0 = _cpu_seconds(pid), len(clock)
     time.sleep(options["seconds"])
@@ -388,11 +395,13 @@ def bench_bare_paced(seconds):
         world.close()
 
 
-def fast_trial(seconds, rsp):
+def fast_trial(seconds, rsp, leave=True):
+    """Fast mode, every topic subscribed; ``leave``: the probe gives the robot its command and leaves (no node in
+    the loop), else it keeps publishing to cmd_vel and fast mode waits for it after each /clock tick."""
     with Launch(sim_args("real_time:=false", f"robot_state_publisher:={str(rsp).lower()}"), "fast") as launch:
         for topic in TOPICS[1:]:  # /clock is subscribed by the RTF probe itself, a process of its own
             subscriber(launch, [topic])
-        result = launch.probe("rtf", seconds=seconds, warmup=3.0)
+        result = launch.probe("rtf", seconds=seconds, warmup=3.0, leave=leave)
         counts = launch.stop_children()
     result["subscriber_messages"] = {k: v for c in counts if c for k, v in c.items()}
     return result
@@ -400,11 +409,12 @@ def fast_trial(seconds, rsp):
 
 def bench_fast(seconds, repeats):
     """Fast mode with and without robot_state_publisher, and bare PyBullet, interleaved; medians."""
-    runs = {"bare": [], "fast": [], "fast_no_rsp": []}
+    runs = {"bare": [], "fast": [], "fast_no_rsp": [], "fast_commander": []}
     for _ in range(repeats):
         runs["bare"].append(bench_bare(seconds / 2))
         runs["fast"].append(fast_trial(seconds, True))
         runs["fast_no_rsp"].append(fast_trial(seconds, False))
+        runs["fast_commander"].append(fast_trial(seconds, False, leave=False))
     out = {}
     for key, trials in runs.items():
         rtfs = [t["rtf"] for t in trials]
@@ -506,7 +516,8 @@ def ros_control_trial(seconds):
     with Launch(args, "ros_control") as launch:
         for topic in ("/mobile_base_controller/odom", "/joint_states", "/tf"):
             subscriber(launch, [topic])
-        result = launch.probe("rtf", seconds=seconds, warmup=3.0, cmd_topics=["/mobile_base_controller/cmd_vel"])
+        result = launch.probe("rtf", seconds=seconds, warmup=3.0, cmd_topics=["/mobile_base_controller/cmd_vel"],
+                              leave=True)
         counts = launch.stop_children()
     result["subscriber_messages"] = {k: v for c in counts if c for k, v in c.items()}
     return result
@@ -561,7 +572,7 @@ def bench_sensors(runs, seconds, realtime_seconds):
         with Launch(sim_args("real_time:=false", *args), "sensors_fast") as launch:
             for topic in topics:
                 subscriber(launch, [topic])
-            trial = launch.probe("rtf", seconds=seconds, warmup=3.0)
+            trial = launch.probe("rtf", seconds=seconds, warmup=3.0, leave=True)
             trial["subscriber_messages"] = {k: v for c in launch.stop_children() if c for k, v in c.items()}
         rtfs.append(trial["rtf"])
         trials.append(trial)
@@ -634,7 +645,7 @@ def bench_worlds(runs, seconds):
             with Launch(sim_args("real_time:=false", "robot_state_publisher:=false", *extra), f"world_{key}") as launch:
                 for topic in TOPICS[1:]:
                     subscriber(launch, [topic])
-                rtf[key].append(launch.probe("rtf", seconds=seconds, warmup=3.0)["rtf"])
+                rtf[key].append(launch.probe("rtf", seconds=seconds, warmup=3.0, leave=True)["rtf"])
     out["rtf_room"], out["rtf_empty"] = statistics.median(rtf["room"]), statistics.median(rtf["empty"])
     out["rtf_runs"] = rtf
     return out
@@ -756,6 +767,8 @@ def table(r):
                  ("  fast / bare", f"{f['rtf'] / b['rtf']:.2f}", ">= 0.5"),
                  ("fast-mode RTF, robot_state_publisher:=false", f"{n['rtf']:.1f}", ">= 40"),
                  ("  fast / bare", f"{n['rtf'] / b['rtf']:.2f}", ">= 0.5")]
+        if r.get("fast_commander"):
+            rows.append(("  the same, a rospy node publishing cmd_vel in the loop", f"{r['fast_commander']['rtf']:.1f}", ""))
     for key, label in (("realtime", "real time, /clock + /odom subscribed"),
                        ("realtime_all_topics", "real time, all four topics subscribed")):
         if r.get(key):
