@@ -49,17 +49,22 @@ def arm_targets(t):
 
 
 def probe_arm_motion(options):
-    """Send a 60 s trajectory (points every 0.1 s) on /arm_controller/command, then measure RTF as probe_rtf."""
+    """Send a long trajectory (``trajectory_s`` of sim time, points every 0.1 s) on /arm_controller/command, then
+    measure RTF as probe_rtf. With ``leave``, the probe closes its command publishers once they were sent (fast
+    mode waits after each /clock tick for nodes that publish commands: staying, the probe measured itself)."""
     import rospy
     from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
     rospy.init_node("bench_arm", disable_signals=True)
     pub = rospy.Publisher("/arm_controller/command", JointTrajectory, queue_size=1, latch=True)
     msg = JointTrajectory(joint_names=ARM_JOINTS)
-    for k in range(1, 601):
+    for k in range(1, int(round(options.get("trajectory_s", 60.0) / 0.1)) + 1):
         msg.points.append(JointTrajectoryPoint(positions=arm_targets(k * 0.1),
                                                time_from_start=rospy.Duration.from_sec(k * 0.1)))
     bench._wait(lambda: pub.get_num_connections() > 0, 60, "the trajectory controller's command topic")
     pub.publish(msg)
+    if options.get("leave"):
+        time.sleep(0.5)  # written at once on the open connection; the controller keeps a trajectory it was sent
+        pub.unregister()
     bench.probe_rtf(options)
 
 
@@ -138,7 +143,9 @@ def bench_arm(seconds, repeats):
         with Launch(args, "arm") as launch:
             for topic in ("/joint_states", "/tf", "/odom", "/arm_controller/state"):
                 subscriber(launch, [topic])
-            runs["sim"].append(launch.probe("arm_motion", seconds=seconds, warmup=3.0)["rtf"])
+            # the trajectory outlasts the window (4 s of warm-up and leaving + the window, at up to RTF 60)
+            runs["sim"].append(launch.probe("arm_motion", seconds=seconds, warmup=3.0, leave=True,
+                                            trajectory_s=60.0 * (seconds + 4.0))["rtf"])
     with Launch(sim_args(f"model:={ARM_MODEL}", f"controllers:={ARM_YAML}", "robot_state_publisher:=false"),
                 "arm_latency") as launch:
         latency = launch.probe("arm_latency", count=20, timeout=300)
