@@ -47,6 +47,8 @@ RESULTS = os.path.join(ROOT, "bench-results")
 MODEL = os.path.join(ROOT, "urdf", "diffbot.urdf.xacro")
 STEP = 1.0 / 240.0
 TOPICS = ["/clock", "/odom", "/joint_states", "/tf"]
+#: (m/s, rad/s): the circle the RTF probe drives every robot in
+CIRCLE = (0.2, 0.5)
 
 
 # ------------------------------------------------------------------------------------------------ helpers
@@ -200,7 +202,7 @@ def probe_rtf(options):
     topics = options.get("cmd_topics") or [f"{ns}/cmd_vel" for ns in options.get("namespaces", [""])]
     pubs = [rospy.Publisher(topic, Twist, queue_size=1, latch=True) for topic in topics]
     circle = Twist()
-    circle.linear.x, circle.angular.z = 0.2, 0.5
+    circle.linear.x, circle.angular.z = CIRCLE
     for pub in pubs:  # drive in circles: wheels, casters and contacts all busy
         pub.publish(circle)
     time.sleep(options.get("warmup", 3.0))
@@ -338,6 +340,17 @@ def bench_world_api(spawns, round_trips):
                             spawns=spawns, round_trips=round_trips)
 
 
+def check_upright(robot, what, limit_deg=30.0):
+    """Raise unless ``robot``'s root link is within ``limit_deg`` of upright: a bare-PyBullet reference whose
+    robot fell over steps fewer contacts (2 against 10 for the arm) and would flatter itself."""
+    import math
+    _, (x, y, z, w) = robot.base_pose()
+    up = 1.0 - 2.0 * (x * x + y * y)  # the world z component of the root link's z axis
+    tilt = math.degrees(math.acos(max(-1.0, min(1.0, up))))
+    if tilt > limit_deg:
+        raise RuntimeError(f"bare PyBullet's {what} fell over (tilted {tilt:.0f} deg): its figure would be wrong")
+
+
 def bench_bare(seconds):
     """The same model (xacro'd, loaded the way bullet_sim loads it) stepped by PyBullet alone."""
     import pybullet
@@ -361,6 +374,7 @@ def bench_bare(seconds):
                 pybullet.stepSimulation(physicsClientId=client)
             steps += 240
         elapsed = time.perf_counter() - start
+        check_upright(robot, "seed robot")
     finally:
         world.close()
     return {"steps_per_s": steps / elapsed, "rtf": steps * STEP / elapsed}
