@@ -344,9 +344,10 @@ def check_upright(robot, what, limit_deg=30.0):
     """Raise unless ``robot``'s root link is within ``limit_deg`` of upright: a bare-PyBullet reference whose
     robot fell over steps fewer contacts (2 against 10 for the arm) and would flatter itself."""
     import math
-    _, (x, y, z, w) = robot.base_pose()
-    up = 1.0 - 2.0 * (x * x + y * y)  # the world z component of the root link's z axis
-    tilt = math.degrees(math.acos(max(-1.0, min(1.0, up))))
+
+    from diffbot_sim.check import drive_check
+    position, quaternion = robot.base_pose()
+    tilt = math.degrees(drive_check.body_sample(0.0, position, quaternion).tilt)
     if tilt > limit_deg:
         raise RuntimeError(f"bare PyBullet's {what} fell over (tilted {tilt:.0f} deg): its figure would be wrong")
 

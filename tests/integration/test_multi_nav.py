@@ -16,8 +16,8 @@ multi_tb3like_navigation.launch); every robot gets its goal at the same moment (
 end SUCCEEDED with its body (ground truth, /gazebo/model_states) within ~xy_tolerance m of the goal.
 
 Either way: no two robots touch (each body's outline from above, ~body_outline: convex corners [x, y] in the
-robot's base frame, tb3like's box and wheels by default; two robots' outlines must never meet, judged on every
-/gazebo/model_states),
+robot's base frame, tb3like's box and wheels by default; two robots' outlines must never meet, judged on each
+/gazebo/model_states the test receives: the newest one whenever it falls behind),
 and TF holds each robot's chain under its prefix, each edge from one node: ``tb3_N/odom -> tb3_N/base_footprint``
 from the simulator and ``tb3_N/map -> tb3_N/odom`` from that robot's gmapping, or ``map -> tb3_N/odom`` from its
 amcl.

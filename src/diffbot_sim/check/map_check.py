@@ -182,18 +182,27 @@ def inside(points, segments):
     return result
 
 
-def solids_on(grid, sections):
-    """The true solids on ``grid``'s cells: a (height, width) bool array, True where a cell's centre lies inside
-    any shape's outline of ``sections`` (:func:`world_section`)."""
-    all_rows, all_cols = np.indices((grid.height, grid.width))
-    centres = grid.centres(all_rows.ravel(), all_cols.ravel())
-    solid = np.zeros(len(centres), dtype=bool)
+def _all_centres(grid):
+    """Every cell's centre of ``grid``, row by row: (height * width, 2)."""
+    rows, cols = np.indices((grid.height, grid.width))
+    return grid.centres(rows.ravel(), cols.ravel())
+
+
+def _inside_any(points, sections):
+    """Whether each of ``points`` ((N, 2)) lies inside any shape's outline of ``sections``."""
+    solid = np.zeros(len(points), dtype=bool)
     for _, segments in sections:
         lo, hi = segments[:, [0, 2]].min(), segments[:, [0, 2]].max()
         ylo, yhi = segments[:, [1, 3]].min(), segments[:, [1, 3]].max()
-        box = (centres[:, 0] >= lo) & (centres[:, 0] <= hi) & (centres[:, 1] >= ylo) & (centres[:, 1] <= yhi)
-        solid[box] |= inside(centres[box], segments)
-    return solid.reshape(grid.height, grid.width)
+        box = (points[:, 0] >= lo) & (points[:, 0] <= hi) & (points[:, 1] >= ylo) & (points[:, 1] <= yhi)
+        solid[box] |= inside(points[box], segments)
+    return solid
+
+
+def solids_on(grid, sections):
+    """The true solids on ``grid``'s cells: a (height, width) bool array, True where a cell's centre lies inside
+    any shape's outline of ``sections`` (:func:`world_section`)."""
+    return _inside_any(_all_centres(grid), sections).reshape(grid.height, grid.width)
 
 
 def true_map(sections, x0, y0, resolution, width, height):
@@ -201,11 +210,10 @@ def true_map(sections, x0, y0, resolution, width, height):
     solid is or a true surface passes within half a cell's diagonal of the centre, 0 (free) elsewhere. Makes a
     fixture's map_server map from a world's geometry."""
     grid = Grid(x0, y0, resolution, width, height, np.zeros((height, width), dtype=np.int16))
-    occupied = solids_on(grid, sections)
+    centres = _all_centres(grid)
     all_segments = np.vstack([s for _, s in sections]) if sections else np.zeros((0, 4))
-    rows, cols = np.indices((height, width))
-    near = distances(grid.centres(rows.ravel(), cols.ravel()), all_segments).reshape(height, width)
-    grid.data[occupied | (near <= resolution * math.sqrt(0.5))] = 100
+    occupied = _inside_any(centres, sections) | (distances(centres, all_segments) <= resolution * math.sqrt(0.5))
+    grid.data[occupied.reshape(height, width)] = 100
     return grid
 
 

@@ -30,5 +30,6 @@ def main():
     map_image.write_map(os.path.join(OUT, "house.yaml"), grid.data[::-1] == 100, RESOLUTION, (X0, Y0),
                         "made by tests/data/multi_way/make_map.py from house.world")
 
+
 if __name__ == "__main__":
     main()
