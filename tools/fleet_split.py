@@ -94,7 +94,7 @@ def rays(count, name, pipe):
             shared.scan_step[i] = step
             shared.scan_seq[i] += 1
         pipe.send(True)
-    pipe.send(time.process_time() - cpu0)
+    pipe.send(time.process_time() - cpu0 if cpu0 is not None else 0.0)
 
 
 def ros_side(count, name, result, connected):
@@ -144,7 +144,7 @@ def ros_side(count, name, result, connected):
     rospy.signal_shutdown("done")
 
 
-def consumer(count, connected, seconds, result):
+def consumer(count, name, connected, seconds, result):
     """Every /rN/odom and /rN/scan subscribed; messages per second over ``seconds`` once connected."""
     import rospy
     from nav_msgs.msg import Odometry
@@ -158,8 +158,12 @@ def consumer(count, connected, seconds, result):
         return count_one
     keep = [rospy.Subscriber(f"/r{i}/odom", Odometry, counter("odom"), queue_size=10) for i in range(count)]
     keep += [rospy.Subscriber(f"/r{i}/scan", LaserScan, counter("scan"), queue_size=10) for i in range(count)]
-    connected.wait(timeout=180.0)
-    time.sleep(1.0)  # the physics starts stepping
+    shared = Shared(count, name)
+    deadline = time.monotonic() + 180.0
+    while int(shared.step[0]) < 240:  # counted from the physics' second sim second on
+        if time.monotonic() > deadline:
+            raise RuntimeError("the physics did not step within 180 s")
+        time.sleep(0.01)
     received.update(odom=0, scan=0)
     cpu0, wall0 = time.process_time(), time.perf_counter()
     time.sleep(seconds)
@@ -188,7 +192,7 @@ def run(count, seconds):
     if pipe.recv() != "ready":
         raise RuntimeError("the ray process did not start")
     children += [context.Process(target=ros_side, args=(count, shared.memory.name, result, connected)),
-                 context.Process(target=consumer, args=(count, connected, seconds - 2.0, result))]
+                 context.Process(target=consumer, args=(count, shared.memory.name, connected, seconds - 2.0, result))]
     for child in children[1:]:
         child.start()
     if not connected.wait(timeout=180.0):
