@@ -206,8 +206,11 @@ class ArmTraits(unittest.TestCase):
 
     def test_gripper_4_cancel_holds_the_jaw_where_it_is(self):
         """A goal to 0.08 from 0.01 (0.7 s at the jaw's 0.1 m/s limit) cancelled after one unpause-pause round
-        trip of the physics of at least 0.1 s: PREEMPTED, and the jaw stays where it was. The round trip runs at real
-        time (in fast mode a busy test node could let the whole 0.7 s pass)."""
+        trip of the physics of at least 0.1 s: PREEMPTED, and the jaw stays where the cancel found it (read while
+        the physics is still paused: read after the unpause, it could catch the jaw still coasting). The hold is
+        the position of the controller's last update, one step before the cancel as in gazebo_ros_control:
+        0.42 mm back at 0.1 m/s, within the 1 mm asked. The round trip runs at real time (in fast mode a busy
+        test node could let the whole 0.7 s pass)."""
         ns = "grip_position"
         client = self.gripper[ns]
         goal = GripperCommandGoal()
@@ -234,12 +237,12 @@ class ArmTraits(unittest.TestCase):
                 client.cancel_goal()
                 wait_for(lambda: client.get_state() in (GoalStatus.PREEMPTED, GoalStatus.SUCCEEDED), 10,
                          f"the goal PREEMPTED (status {client.get_state()})")
+                stopped = self.jaw(ns)  # still paused
             finally:
                 unpause()
             if client.get_state() == GoalStatus.PREEMPTED:
                 break
         self.assertEqual(client.get_state(), GoalStatus.PREEMPTED, "the goal ended before its cancel, 3 times")
-        stopped = self.jaw(ns)
         sim_sleep(1.0)
         later = self.jaw(ns)
         self.assertAlmostEqual(later, stopped, delta=0.001, msg="the jaw moved on after the cancel")
