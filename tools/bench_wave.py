@@ -13,8 +13,9 @@ Items:
   fleet      TurtleBot3-class robots (tests/data/multi_way/tb3like: diff drive at 30 Hz, 360-beam laser at
              5 Hz; its IMU left out) in one simulator at real time, every robot's /odom and /scan subscribed:
              the largest count at RTF >= 0.99, with and without lasers and with a robot_state_publisher each;
-             how many of them bare PyBullet steps at real time (same model, same step); the simulator's cost
-             per robot (CPU us per sim second).
+             how many of them bare PyBullet steps at real time (same model, same step), casting their lasers'
+             scans as the simulator does (the reference) and physics only; the simulator's cost per robot (CPU
+             us per sim second).
 """
 import json
 import os
@@ -274,10 +275,30 @@ def loadable(model):
     return text, parsed
 
 
-def bare_fleet(count, seconds, model):
-    """``count`` of the same robots stepped by PyBullet alone (same step), wheels turning: their RTF."""
+def fleet_laser(model):
+    """``(link, RayConfig)`` of the model's ray sensor, read as the simulator reads it (``parse_sensor``)."""
+    from diffbot_sim.sensors.ray import parse_sensor
+    for gazebo in ET.parse(model).getroot().findall("gazebo"):
+        for sensor in gazebo.findall("sensor"):
+            if sensor.get("type") == "ray":
+                return gazebo.get("reference"), parse_sensor(sensor, f"{model}: <gazebo reference=...><sensor>")
+    raise ValueError(f"{model}: no <sensor type=\"ray\">")
+
+
+def bare_fleet(count, seconds, model, lasers):
+    """``count`` of the same robots stepped by PyBullet alone (same step), wheels turning: their RTF.
+
+    With ``lasers``, bare PyBullet also casts every robot's scan as the simulator casts it: the model's
+    rays (``ray_directions``) from the laser's link, at its ``<update_rate>``, all robots on the same step
+    (the simulator's lasers share one schedule), through ``World.ray_batch``. Nothing is made of the hits:
+    no noise, no message, no ROS."""
     from diffbot_sim.physics import World
+    from diffbot_sim.sensors import ray as ray_sensor
     text, parsed = loadable(model)
+    link, cfg = fleet_laser(model)
+    pose, _ = ray_sensor.mounted_pose(cfg, parsed, link)
+    directions = ray_sensor.ray_directions(cfg)
+    every = max(1, round(1.0 / cfg.update_rate / STEP))
     world = World(STEP)
     try:
         for i in range(count):
@@ -289,6 +310,11 @@ def bare_fleet(count, seconds, model):
         while time.perf_counter() - start < seconds:
             world.step()
             steps += 1
+            if lasers and steps % every == 0:
+                for robot in world.robots:
+                    origin, rotation = ray_sensor.sensor_pose(*robot.link_pose(link), pose)
+                    world.ray_batch(*ray_sensor.world_rays(origin, rotation, directions, cfg.range_min,
+                                                           cfg.range_max))
         elapsed = time.perf_counter() - start
         for robot in world.robots:
             check_upright(robot, "fleet robot")
@@ -321,9 +347,14 @@ def largest(trial, start):
 
 def bench_fleet(seconds):
     laser_model, bare_model = fleet_model(True), fleet_model(False)
-    bare = {n: bare_fleet(n, 5.0, laser_model) for n in (20, 40)}
+    # The reference does the robots' own PyBullet work: their physics and their lasers' rays. A ray's cost
+    # grows with what it hits, so it is measured at counts near the answer (a full 10-wide grid).
+    bare = {n: bare_fleet(n, 5.0, laser_model, True) for n in (40, 60, 80)}
     bare_count = statistics.median([n * rtf for n, rtf in bare.items()])
-    out = {"bare_pybullet_robots_at_real_time": round(bare_count, 1), "bare_rtf": bare}
+    physics = {n: bare_fleet(n, 5.0, laser_model, False) for n in (20, 40)}
+    out = {"bare_pybullet_robots_at_real_time": round(bare_count, 1), "bare_rtf": bare,
+           "bare_physics_only_robots_at_real_time": round(statistics.median([n * r for n, r in physics.items()]), 1),
+           "bare_physics_only_rtf": physics}
     for key, model, rsp, laser in (("laser", laser_model, False, True), ("no_laser", bare_model, False, False),
                                    ("laser_rsp", laser_model, True, True)):
         count, trials = largest(lambda n: fleet_trial(n, seconds, model, rsp, laser),
@@ -358,7 +389,9 @@ def rows(r):
                 ("  resets per second per core", f"{g['resets_per_s_cpu']:.0f}", "")]
     if r.get("fleet"):
         f = r["fleet"]
-        out += [("bare PyBullet: TurtleBot3-class robots at real time", f"{f['bare_pybullet_robots_at_real_time']:.0f}", ""),
+        out += [("bare PyBullet: TurtleBot3-class robots at real time, their lasers cast",
+                 f"{f['bare_pybullet_robots_at_real_time']:.0f}", ""),
+                ("  the same, physics only (no rays)", f"{f.get('bare_physics_only_robots_at_real_time', 0):.0f}", ""),
                 ("robots at RTF >= 1, 360-beam lasers @5 Hz, odom+scan subscribed",
                  f"{f['laser']['robots_at_real_time']} ({f['ratio_laser_to_bare']:.2f} of bare)", ">= 100 or >= 0.8 of bare"),
                 ("  the same without lasers", f"{f['no_laser']['robots_at_real_time']}", ""),

@@ -1,16 +1,16 @@
 """How many laser robots could a simulator split over three processes keep at real time on this machine?
 
 A measurement for docs/fleet.md, not a simulator: ``bullet_sim`` runs physics, rays and ROS on one thread (PyBullet
-holds Python's lock through ``stepSimulation`` and ``rayTestBatch``), which caps a laser fleet near half of
-what bare PyBullet steps. This script runs the design that would lift the cap, with the fleet's real robot
-and the simulator's own message builders, and reports whether its physics keeps real time:
+holds Python's lock through ``stepSimulation`` and ``rayTestBatch``), which caps a laser fleet at about 0.7 of
+what bare PyBullet steps and casts. This script runs the design that would lift the cap, with the fleet's real
+robot and the simulator's own message builders, and reports whether its physics keeps real time:
 
 * **physics** (this process, no rospy): ``count`` tb3like robots (as ``make bench`` item ``fleet`` loads
   them, wheels turning) stepped at real time; every 1/30 s of sim time their base poses and twists go to
   shared memory and a sixth of the robots are due a scan (each robot at 5 Hz).
 * **rays** (a child, no rospy): a mirror PyBullet world holding the same robots; at each scan tick it puts
-  every robot where the physics has it and casts the due robots' 360-beam, 3.5 m scans (laser 0.18 m above
-  the base) into shared memory. The physics waits for the previous tick's scans only when the next are due.
+  every robot where the physics has it and casts the due robots' 360-beam, 3.5 m scans (from the laser's
+  link) into shared memory. The physics waits for the previous tick's scans only when the next are due.
 * **ros** (a child, a rospy node): publishes ``/clock`` at every step it sees, each robot's
   ``/rN/odom`` (``messages.common.odometry``) at 30 Hz and ``/rN/scan`` (``LaserScanBuilder``) when cast.
 * **consumer** (a child, a rospy node): subscribes to every ``/rN/odom`` and ``/rN/scan``, as ``make bench``'s
@@ -41,7 +41,7 @@ sys.path.insert(0, os.path.join(bench.ROOT, "src"))
 STEP = bench.STEP          # s: the fleet's step, as make bench
 ODOM_EVERY = 8             # steps: odometry at 30 Hz
 SCAN_GROUPS = 6            # scan ticks per scan period: each robot scans at 5 Hz
-BEAMS, RANGE_MIN, RANGE_MAX, LASER_HEIGHT = 360, 0.12, 3.5, 0.18
+BEAMS, RANGE_MIN, RANGE_MAX, LASER_LINK = 360, 0.12, 3.5, "base_scan"
 
 
 def load_fleet(count):
@@ -50,6 +50,13 @@ def load_fleet(count):
     text, parsed = bench_wave.loadable(bench_wave.fleet_model(True))
     world = World(STEP)
     return world, [world.load_robot(text, parsed, (float(i % 10), float(i // 10), 0.0)) for i in range(count)]
+
+
+def laser_offset(world, robot):
+    """The laser's position in the robot's base frame (its link fixed to the base, turned as the base)."""
+    import pybullet
+    base = pybullet.invertTransform(*pybullet.getBasePositionAndOrientation(robot.body, physicsClientId=world.client))
+    return np.array(pybullet.multiplyTransforms(*base, *robot.link_pose(LASER_LINK))[0])
 
 
 class Shared:
@@ -74,6 +81,7 @@ def rays(count, name, pipe):
     shared = Shared(count, name)
     angles = np.linspace(-math.pi, math.pi, BEAMS, endpoint=False)
     directions = np.c_[np.cos(angles), np.sin(angles), np.zeros(BEAMS)]
+    laser = laser_offset(world, robots[0])
     pipe.send("ready")
     cpu0 = None
     while (request := pipe.recv()) is not None:
@@ -83,11 +91,8 @@ def rays(count, name, pipe):
         for robot, pose in zip(robots, poses):
             pybullet.resetBasePositionAndOrientation(robot.body, pose[:3], pose[3:7], physicsClientId=world.client)
         for i in due:
-            x, y, z, qx, qy, qz, qw = poses[i, :7]
-            yaw = math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
-            c, s = math.cos(yaw), math.sin(yaw)
-            turned = directions @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
-            origin = np.array([x, y, z + LASER_HEIGHT])
+            turn = np.reshape(pybullet.getMatrixFromQuaternion(poses[i, 3:7]), (3, 3))
+            origin, turned = poses[i, :3] + turn @ laser, directions @ turn.T
             hits = pybullet.rayTestBatch(origin + RANGE_MIN * turned, origin + RANGE_MAX * turned,
                                          physicsClientId=world.client)
             shared.ranges[i] = [RANGE_MIN + (RANGE_MAX - RANGE_MIN) * hit[2] for hit in hits]
