@@ -281,7 +281,8 @@ def fleet_laser(model):
     for gazebo in ET.parse(model).getroot().findall("gazebo"):
         for sensor in gazebo.findall("sensor"):
             if sensor.get("type") == "ray":
-                return gazebo.get("reference"), parse_sensor(sensor, f"{model}: <gazebo reference=...><sensor>")
+                link = gazebo.get("reference")
+                return link, parse_sensor(sensor, f"{model}: <gazebo reference=\"{link}\"><sensor>")
     raise ValueError(f"{model}: no <sensor type=\"ray\">")
 
 
@@ -295,10 +296,11 @@ def bare_fleet(count, seconds, model, lasers):
     from diffbot_sim.physics import World
     from diffbot_sim.sensors import ray as ray_sensor
     text, parsed = loadable(model)
-    link, cfg = fleet_laser(model)
-    pose, _ = ray_sensor.mounted_pose(cfg, parsed, link)
-    directions = ray_sensor.ray_directions(cfg)
-    every = max(1, round(1.0 / cfg.update_rate / STEP))
+    if lasers:
+        link, cfg = fleet_laser(model)
+        pose, _ = ray_sensor.mounted_pose(cfg, parsed, link)
+        directions = ray_sensor.ray_directions(cfg)
+        every = max(1, round(1.0 / cfg.update_rate / STEP))
     world = World(STEP)
     try:
         for i in range(count):

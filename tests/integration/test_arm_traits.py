@@ -172,8 +172,10 @@ class ArmTraits(unittest.TestCase):
                 self.assert_clamped(ns, name, "on the stall")
                 sim_sleep(1.0)
                 later = self.truth.object(name)[0]
-                # Bullet lets a box squeezed at 20 N creep by up to ~1 mm/s (docs/migrating.md, Known limits)
-                self.assertLess(math.dist(held, later), 0.003, f"/{ns}: the held box moves: {held} -> {later}, "
+                # Bullet lets a box squeezed at 20 N creep and rock (docs/migrating.md, Known limits): 0-0.6 mm in
+                # this second in 12 measurements, once 3.2 mm as it rocked (1.2 mm up, 2.9 mm along the jaws). A box
+                # let go moves by centimetres; the bound is the vise's window along the jaws (assert_clamped's x).
+                self.assertLess(math.dist(held, later), 0.005, f"/{ns}: the held box moves: {held} -> {later}, "
                                 f"the jaw at {self.jaw(ns):.4f} m")
                 self.assert_clamped(ns, name, "1 s after the stall")
                 self.assertAlmostEqual(self.jaw(ns), BOX[1], delta=0.003, msg=f"/{ns}: the jaw let go after the stall")
