@@ -1,4 +1,4 @@
-"""How many laser robots could a simulator split over three processes keep at real time on this machine?
+"""How many laser robots could a simulator split over processes keep at real time on this machine?
 
 A measurement for docs/fleet.md, not a simulator: ``bullet_sim`` runs physics, rays and ROS on one thread (PyBullet
 holds Python's lock through ``stepSimulation`` and ``rayTestBatch``), which caps a laser fleet at about 0.7 of
@@ -11,6 +11,8 @@ robot and the simulator's own message builders, and reports whether its physics 
 * **rays** (a child, no rospy): a mirror PyBullet world holding the same robots; at each scan tick it puts
   every robot where the physics has it and casts the due robots' 360-beam, 3.5 m scans (from the laser's
   link) into shared memory. The physics waits for the previous tick's scans only when the next are due.
+  With ``--rays-in-physics`` there is no ray process: the physics casts the scans itself between its steps
+  (the smaller split: physics and rays in one process, ROS in another).
 * **ros** (a child, a rospy node): publishes ``/clock`` at every step it sees, each robot's
   ``/rN/odom`` (``messages.common.odometry``) at 30 Hz and ``/rN/scan`` (``LaserScanBuilder``) when cast.
 * **consumer** (a child, a rospy node): subscribes to every ``/rN/odom`` and ``/rN/scan``, as ``make bench``'s
@@ -74,14 +76,33 @@ class Shared:
         self.step, self.poses, self.ranges, self.scan_seq, self.scan_step = views
 
 
-def rays(count, name, pipe):
+class Scanner:
+    """Casts the due robots' scans in ``world`` from poses ``(count, 7)`` into the shared ranges."""
+
+    def __init__(self, world, robots, shared, threads):
+        angles = np.linspace(-math.pi, math.pi, BEAMS, endpoint=False)
+        self.directions = np.c_[np.cos(angles), np.sin(angles), np.zeros(BEAMS)]
+        self.laser = laser_offset(world, robots[0])
+        self.world, self.shared, self.threads = world, shared, threads
+
+    def cast(self, step, due, poses):
+        import pybullet
+        for i in due:
+            turn = np.reshape(pybullet.getMatrixFromQuaternion(poses[i, 3:7]), (3, 3))
+            origin, turned = poses[i, :3] + turn @ self.laser, self.directions @ turn.T
+            hits = pybullet.rayTestBatch(origin + RANGE_MIN * turned, origin + RANGE_MAX * turned,
+                                         numThreads=self.threads, physicsClientId=self.world.client)
+            self.shared.ranges[i] = [RANGE_MIN + (RANGE_MAX - RANGE_MIN) * hit[2] for hit in hits]
+            self.shared.scan_step[i] = step
+            self.shared.scan_seq[i] += 1
+
+
+def rays(count, name, pipe, threads):
     """The ray process: a mirror world, scans cast on request."""
     import pybullet
     world, robots = load_fleet(count)
     shared = Shared(count, name)
-    angles = np.linspace(-math.pi, math.pi, BEAMS, endpoint=False)
-    directions = np.c_[np.cos(angles), np.sin(angles), np.zeros(BEAMS)]
-    laser = laser_offset(world, robots[0])
+    scanner = Scanner(world, robots, shared, threads)
     pipe.send("ready")
     cpu0 = None
     while (request := pipe.recv()) is not None:
@@ -90,14 +111,7 @@ def rays(count, name, pipe):
         step, due, poses = request
         for robot, pose in zip(robots, poses):
             pybullet.resetBasePositionAndOrientation(robot.body, pose[:3], pose[3:7], physicsClientId=world.client)
-        for i in due:
-            turn = np.reshape(pybullet.getMatrixFromQuaternion(poses[i, 3:7]), (3, 3))
-            origin, turned = poses[i, :3] + turn @ laser, directions @ turn.T
-            hits = pybullet.rayTestBatch(origin + RANGE_MIN * turned, origin + RANGE_MAX * turned,
-                                         physicsClientId=world.client)
-            shared.ranges[i] = [RANGE_MIN + (RANGE_MAX - RANGE_MIN) * hit[2] for hit in hits]
-            shared.scan_step[i] = step
-            shared.scan_seq[i] += 1
+        scanner.cast(step, due, poses)
         pipe.send(True)
     pipe.send(time.process_time() - cpu0 if cpu0 is not None else 0.0)
 
@@ -179,8 +193,9 @@ def consumer(count, name, connected, seconds, result):
     rospy.signal_shutdown("done")
 
 
-def run(count, seconds):
-    """One run: the physics steps ``seconds`` of sim time at real time with the other three running."""
+def run(count, seconds, rays_in_physics=False, ray_threads=0):
+    """One run: the physics steps ``seconds`` of sim time at real time with the others running. With
+    ``rays_in_physics`` the physics process casts the scans itself (no ray process: the two-process split)."""
     import pybullet
     world, robots = load_fleet(count)
     for robot in robots:
@@ -192,13 +207,17 @@ def run(count, seconds):
     context = multiprocessing.get_context("fork")
     pipe, child_pipe = context.Pipe()
     result, connected = context.Queue(), context.Event()
-    children = [context.Process(target=rays, args=(count, shared.memory.name, child_pipe))]
-    children[0].start()
-    if pipe.recv() != "ready":
-        raise RuntimeError("the ray process did not start")
+    children = []
+    if rays_in_physics:
+        scanner = Scanner(world, robots, shared, ray_threads)
+    else:
+        children.append(context.Process(target=rays, args=(count, shared.memory.name, child_pipe, ray_threads)))
+        children[0].start()
+        if pipe.recv() != "ready":
+            raise RuntimeError("the ray process did not start")
     children += [context.Process(target=ros_side, args=(count, shared.memory.name, result, connected)),
                  context.Process(target=consumer, args=(count, shared.memory.name, connected, seconds - 2.0, result))]
-    for child in children[1:]:
+    for child in children[-2:]:
         child.start()
     if not connected.wait(timeout=180.0):
         raise RuntimeError("the consumer's subscriptions did not connect within 180 s")
@@ -216,21 +235,28 @@ def run(count, seconds):
                 shared.poses[i] = (*position, *orientation, *linear, *angular)
             shared.step[0] = steps
             group = (steps // ODOM_EVERY) % SCAN_GROUPS
-            if pending:
-                pipe.recv()
-            pipe.send((steps, [i for i in range(count) if i % SCAN_GROUPS == group], shared.poses[:, :7].copy()))
-            pending = True
+            due = [i for i in range(count) if i % SCAN_GROUPS == group]
+            if rays_in_physics:
+                scanner.cast(steps, due, shared.poses[:, :7])
+            else:
+                if pending:
+                    pipe.recv()
+                pipe.send((steps, due, shared.poses[:, :7].copy()))
+                pending = True
         ahead = start + steps * STEP - time.perf_counter()
         if ahead > 0:
             time.sleep(ahead)
     wall = time.perf_counter() - start
     physics_cpu = time.process_time() - cpu0
-    if pending:
-        pipe.recv()
-    pipe.send(None)
-    ray_cpu = pipe.recv()
+    ray_cpu = 0.0
+    if not rays_in_physics:
+        if pending:
+            pipe.recv()
+        pipe.send(None)
+        ray_cpu = pipe.recv()
     shared.step[0] = -1
-    out = {"robots": count, "physics_rtf": round(seconds / wall, 3),
+    out = {"robots": count, "rays": "in the physics process" if rays_in_physics else "in a ray process",
+           "ray_threads": ray_threads, "physics_rtf": round(seconds / wall, 3),
            "physics_core_share": round(physics_cpu / wall, 3), "ray_core_share": round(ray_cpu / wall, 3),
            "due_per_s": {"odom": count / (ODOM_EVERY * STEP), "scan": count / (ODOM_EVERY * SCAN_GROUPS * STEP)}}
     for _ in range(2):
@@ -249,6 +275,10 @@ def main():
     parser.add_argument("counts", type=int, nargs="+", help="robots per run")
     parser.add_argument("--seconds", type=float, default=20.0, help="sim seconds stepped per run")
     parser.add_argument("--repeats", type=int, default=1)
+    parser.add_argument("--rays-in-physics", action="store_true",
+                        help="cast the scans in the physics process (two processes: physics and rays, ROS)")
+    parser.add_argument("--ray-threads", type=int, default=0,
+                        help="rayTestBatch's numThreads (0: Bullet's pool, as the simulator casts; 1: one thread)")
     options = parser.parse_args()
     port = bench.free_port()
     os.environ["ROS_MASTER_URI"] = f"http://localhost:{port}"
@@ -263,7 +293,8 @@ def main():
             time.sleep(0.05)
         for count in options.counts:
             for _ in range(options.repeats):
-                print(json.dumps(run(count, options.seconds)), flush=True)
+                print(json.dumps(run(count, options.seconds, options.rays_in_physics, options.ray_threads)),
+                      flush=True)
     finally:
         master.terminate()
         master.wait(timeout=10)
