@@ -43,22 +43,18 @@ sys.path.insert(0, os.path.join(bench.ROOT, "src"))
 STEP = bench.STEP          # s: the fleet's step, as make bench
 ODOM_EVERY = 8             # steps: odometry at 30 Hz
 SCAN_GROUPS = 6            # scan ticks per scan period: each robot scans at 5 Hz
-BEAMS, RANGE_MIN, RANGE_MAX, LASER_LINK = 360, 0.12, 3.5, "base_scan"
+BEAMS, RANGE_MIN, RANGE_MAX = 360, 0.12, 3.5  # tb3like's <ray>, for the messages (the casting reads the model)
 
 
 def load_fleet(count):
-    """``(World, robots)``: ``count`` tb3like robots with their lasers on make bench's 1 m grid."""
+    """``(World, robots, (laser link, RayConfig), parsed model)``: ``count`` tb3like robots with their lasers on
+    make bench's 1 m grid, the laser as ``bench_wave.fleet_laser`` reads it."""
     from diffbot_sim.physics import World
-    text, parsed = bench_wave.loadable(bench_wave.fleet_model(True))
+    model = bench_wave.fleet_model(True)
+    text, parsed = bench_wave.loadable(model)
     world = World(STEP)
-    return world, [world.load_robot(text, parsed, (float(i % 10), float(i // 10), 0.0)) for i in range(count)]
-
-
-def laser_offset(world, robot):
-    """The laser's position in the robot's base frame (its link fixed to the base, turned as the base)."""
-    import pybullet
-    base = pybullet.invertTransform(*pybullet.getBasePositionAndOrientation(robot.body, physicsClientId=world.client))
-    return np.array(pybullet.multiplyTransforms(*base, *robot.link_pose(LASER_LINK))[0])
+    robots = [world.load_robot(text, parsed, (float(i % 10), float(i // 10), 0.0)) for i in range(count)]
+    return world, robots, bench_wave.fleet_laser(model), parsed
 
 
 class Shared:
@@ -77,22 +73,27 @@ class Shared:
 
 
 class Scanner:
-    """Casts the due robots' scans in ``world`` from poses ``(count, 7)`` into the shared ranges."""
+    """Casts the due robots' scans in ``world`` into the shared ranges, from where its robots are now: the
+    model's rays from the laser's link (``Robot.link_pose``: PyBullet's base pose is the inertial frame, not
+    the link's), as the simulator and ``bench_wave.bare_fleet`` cast them."""
 
-    def __init__(self, world, robots, shared, threads):
-        angles = np.linspace(-math.pi, math.pi, BEAMS, endpoint=False)
-        self.directions = np.c_[np.cos(angles), np.sin(angles), np.zeros(BEAMS)]
-        self.laser = laser_offset(world, robots[0])
-        self.world, self.shared, self.threads = world, shared, threads
+    def __init__(self, world, robots, laser, parsed, shared, threads):
+        from diffbot_sim.sensors import ray as ray_sensor
+        self.link, self.cfg = laser
+        self.pose, _ = ray_sensor.mounted_pose(self.cfg, parsed, self.link)
+        self.directions = ray_sensor.ray_directions(self.cfg)
+        self.world, self.robots, self.shared, self.threads = world, robots, shared, threads
 
-    def cast(self, step, due, poses):
+    def cast(self, step, due):
         import pybullet
+
+        from diffbot_sim.sensors import ray as ray_sensor
+        cfg = self.cfg
         for i in due:
-            turn = np.reshape(pybullet.getMatrixFromQuaternion(poses[i, 3:7]), (3, 3))
-            origin, turned = poses[i, :3] + turn @ self.laser, self.directions @ turn.T
-            hits = pybullet.rayTestBatch(origin + RANGE_MIN * turned, origin + RANGE_MAX * turned,
-                                         numThreads=self.threads, physicsClientId=self.world.client)
-            self.shared.ranges[i] = [RANGE_MIN + (RANGE_MAX - RANGE_MIN) * hit[2] for hit in hits]
+            origin, rotation = ray_sensor.sensor_pose(*self.robots[i].link_pose(self.link), self.pose)
+            starts, ends = ray_sensor.world_rays(origin, rotation, self.directions, cfg.range_min, cfg.range_max)
+            hits = pybullet.rayTestBatch(starts, ends, numThreads=self.threads, physicsClientId=self.world.client)
+            self.shared.ranges[i] = ray_sensor.raw_ranges([hit[2] for hit in hits], cfg.range_min, cfg.range_max)
             self.shared.scan_step[i] = step
             self.shared.scan_seq[i] += 1
 
@@ -100,9 +101,9 @@ class Scanner:
 def rays(count, name, pipe, threads):
     """The ray process: a mirror world, scans cast on request."""
     import pybullet
-    world, robots = load_fleet(count)
+    world, robots, laser, parsed = load_fleet(count)
     shared = Shared(count, name)
-    scanner = Scanner(world, robots, shared, threads)
+    scanner = Scanner(world, robots, laser, parsed, shared, threads)
     pipe.send("ready")
     cpu0 = None
     while (request := pipe.recv()) is not None:
@@ -111,7 +112,7 @@ def rays(count, name, pipe, threads):
         step, due, poses = request
         for robot, pose in zip(robots, poses):
             pybullet.resetBasePositionAndOrientation(robot.body, pose[:3], pose[3:7], physicsClientId=world.client)
-        scanner.cast(step, due, poses)
+        scanner.cast(step, due)
         pipe.send(True)
     pipe.send(time.process_time() - cpu0 if cpu0 is not None else 0.0)
 
@@ -197,7 +198,7 @@ def run(count, seconds, rays_in_physics=False, ray_threads=0):
     """One run: the physics steps ``seconds`` of sim time at real time with the others running. With
     ``rays_in_physics`` the physics process casts the scans itself (no ray process: the two-process split)."""
     import pybullet
-    world, robots = load_fleet(count)
+    world, robots, laser, parsed = load_fleet(count)
     for robot in robots:
         robot.set_velocities(robot.indices(["wheel_left_joint", "wheel_right_joint"]), [2.0, 3.0], [1.0, 1.0])
     for _ in range(240):
@@ -209,7 +210,7 @@ def run(count, seconds, rays_in_physics=False, ray_threads=0):
     result, connected = context.Queue(), context.Event()
     children = []
     if rays_in_physics:
-        scanner = Scanner(world, robots, shared, ray_threads)
+        scanner = Scanner(world, robots, laser, parsed, shared, ray_threads)
     else:
         children.append(context.Process(target=rays, args=(count, shared.memory.name, child_pipe, ray_threads)))
         children[0].start()
@@ -237,7 +238,7 @@ def run(count, seconds, rays_in_physics=False, ray_threads=0):
             group = (steps // ODOM_EVERY) % SCAN_GROUPS
             due = [i for i in range(count) if i % SCAN_GROUPS == group]
             if rays_in_physics:
-                scanner.cast(steps, due, shared.poses[:, :7])
+                scanner.cast(steps, due)
             else:
                 if pending:
                     pipe.recv()
