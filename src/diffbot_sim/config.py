@@ -53,6 +53,7 @@ class SimConfig:
     enable_ros_network: bool = True  # false: no /gazebo services or topics (gazebo_ros's parameter)
     gazebo_namespace: str = "/gazebo"  # where the gazebo_ros world API lives (spawn_model -gazebo_namespace)
     physics_engine: str = "ode"  # what the world launch asked for; the engine is always Bullet (noted)
+    ray_process: bool = False  # real time: ray sensors cast in a helper process on the other core (fleets)
 
 
 @dataclass
@@ -187,7 +188,7 @@ def sim_config(params):
     cfg.gazebo_namespace = "/" + check_string(name("gazebo_namespace"), cfg.gazebo_namespace).strip("/")
     cfg.physics_engine = check_string(name("physics_engine"), cfg.physics_engine, allow_empty=True)
     for key in ("gui", "real_time", "debug_cmd_applied", "publish_ground_truth", "paused",
-                "autostart_controllers", "enable_ros_network", "wait_for_nodes"):
+                "autostart_controllers", "enable_ros_network", "wait_for_nodes", "ray_process"):
         setattr(cfg, key, check_bool(name(key), getattr(cfg, key)))
     cfg.time_step = check_number(name("time_step"), cfg.time_step, low=1e-5, high=0.05)
     cfg.real_time_factor = check_number(name("real_time_factor"), cfg.real_time_factor, low=1e-3)

@@ -115,3 +115,11 @@ def yaw_from_quaternion(x, y, z, w):
 def quaternion_from_yaw(yaw):
     """(x, y, z, w) of a rotation by ``yaw`` [rad] about +z."""
     return 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)
+
+
+def rays_along(position, rotation, directions, near, far):
+    """Start and end points (each (rays, 3), C-contiguous float64) of rays from ``near`` to ``far`` [m] along
+    ``directions`` ((rays, 3), unit, in the frame of ``rotation``) from ``position``: a ray sensor's rays in the
+    world (one formula, so rays cast in the ray process are the very numbers cast in place)."""
+    world = directions @ rotation.T
+    return np.ascontiguousarray(position + world * near), np.ascontiguousarray(position + world * far)

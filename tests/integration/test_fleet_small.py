@@ -7,9 +7,11 @@ Every robot's scan is subscribed, and every robot sees the others where ground t
 (the only part of a robot at the beams' height; a robot behind another is hidden, as ray casting hides it)
 reads the distance to it, and each beam that ground truth says passes clear of every robot reads no hit. Then
 the ring robots drive 0.2 m along the ring and the inner one turns, and the scans are judged again against
-the moved bodies. Geometry: test_multi_way.py (the robot's laser mount, ray_hits).
+the moved bodies. Geometry: test_multi_way.py (the robot's laser mount, ray_hits). With ``~ray_process`` (as
+fleet_small.test sets it) the rays are cast in the simulator's helper process, which must be running.
 """
 import math
+import os
 import sys
 import unittest
 
@@ -60,6 +62,20 @@ class FleetSmallTest(unittest.TestCase):
         for n in cls.names:
             wait(cls.scan[n].get, 30.0, f"/{n}/scan")
             wait(lambda: cls.cmd[n].get_num_connections() > 0, 20.0, f"/{n}/cmd_vel subscriber")
+
+    def test_0_the_ray_process_runs_when_asked(self):
+        if not rospy.get_param(SIM + "/ray_process", False):
+            self.skipTest("~ray_process is off: the rays are cast in the simulator's process")
+        helpers = []
+        for pid in filter(str.isdigit, os.listdir("/proc")):
+            try:
+                with open(f"/proc/{pid}/cmdline", "rb") as f:
+                    command = f.read().split(b"\0")
+            except OSError:
+                continue
+            if b"diffbot_sim.physics.ray_mirror" in command:
+                helpers.append(pid)
+        self.assertEqual(len(helpers), 1, "one ray process (python -m diffbot_sim.physics.ray_mirror) runs")
 
     def state(self, name):
         resp = self.get_state(name, "world")

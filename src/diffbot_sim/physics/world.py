@@ -42,7 +42,7 @@ class World:
         time_step: s. gravity: m/s^2 along z.
     """
 
-    def __init__(self, time_step, gravity=-9.81, gui=False):
+    def __init__(self, time_step, gravity=-9.81, gui=False, ray_process=False):
         self.client = pybullet.connect(pybullet.GUI if gui else pybullet.DIRECT)
         if self.client < 0:
             raise RuntimeError("could not connect to PyBullet")
@@ -54,7 +54,17 @@ class World:
         self.laser_retro = {}  # (PyBullet body, link index) -> Gazebo laser_retro, for hits that have one
         self.landing_erp = min(1.0, LANDING_CORRECTION_RATE * time_step)
         self.landing = {}  # Robot -> [steps it has rested, steps left] while it is set down (lift_out)
+        self.ray_threads = 0  # rayTestBatch's numThreads (0: Bullet's pool picks)
+        self.steps = 0  # physics steps taken
+        self._boxes = []  # add_kinematic_box's bodies
+        self._movable = {}  # body -> its revolute and prismatic joints' indices (the mirror's state)
+        self._state_sent = None  # self.steps when the mirror was last sent the state
         self._setup()
+        self.ray_helper = None
+        if ray_process:
+            from diffbot_sim.physics.ray_process import RayProcess
+            self.ray_helper = RayProcess(time_step, gravity)
+            self.ray_helper.plane(self.plane)
 
     def _setup(self):
         c = self.client
@@ -93,6 +103,8 @@ class World:
         self.robots.append(robot)
         self.lift_out(robot)
         self.laser_retro.update(robot.laser_retro())
+        if self.ray_helper is not None:
+            self.ray_helper.replay("load_robot", (urdf_text, model, position, yaw, orientation), [body])
         return robot
 
     def load_world(self, world, mesh_cache):
@@ -114,7 +126,7 @@ class World:
         if world.has_ground and self.plane is not None:
             pybullet.removeBody(self.plane, physicsClientId=self.client)
             self.plane = None
-        built = 0
+        built, before = 0, len(self.world_bodies)
         for body in world.bodies:
             shapes = [s for s in body.shapes if s.kind != "plane" or body.static]
             if not shapes:
@@ -142,6 +154,9 @@ class World:
             if body.shapes[0].surface.get("laser_retro"):
                 self.laser_retro[(uid, -1)] = float(body.shapes[0].surface["laser_retro"])
             built += 1
+        if self.ray_helper is not None:
+            self.ray_helper.replay("load_world", (world, mesh_cache), [uid for uid, _ in self.world_bodies[before:]])
+            self.ray_helper.plane(self.plane)
         return built
 
     def _compound(self, shapes, static, mesh_cache):
@@ -257,7 +272,8 @@ class World:
         for lo in range(0, count, RAY_BATCH_LIMIT):
             hi = min(lo + RAY_BATCH_LIMIT, count)
             # numThreads 0: PyBullet picks max(1, rays / 16) threads of its pool.
-            hits = pybullet.rayTestBatch(starts[lo:hi], ends[lo:hi], numThreads=0, physicsClientId=self.client)
+            hits = pybullet.rayTestBatch(starts[lo:hi], ends[lo:hi], numThreads=self.ray_threads,
+                                         physicsClientId=self.client)
             if len(hits) != hi - lo:
                 raise RuntimeError(f"rayTestBatch returned {len(hits)} results for {hi - lo} rays")
             bodies[lo:hi] = [h[0] for h in hits]
@@ -265,6 +281,45 @@ class World:
             fractions[lo:hi] = [h[2] for h in hits]
         fractions[bodies < 0] = 1.0
         return fractions, bodies, links
+
+    # -- rays cast in the helper process (``ray_process``): the same answers, later in wall time ----------------
+    def cast_later(self, key, directions, near, far, position, rotation):
+        """Hand a ray sensor's rays to the ray process: ``directions`` ((N, 3), its frame; sent once per ``key``,
+        again only when a different array is given) from ``near`` to ``far`` [m], the sensor at ``position``
+        (3,) / ``rotation`` (3, 3), cast against the world as it is now (the state is sent with the first cast
+        after each step). The rays are ``transforms.rays_along`` of these. Returns a ticket for
+        :meth:`cast_answer`."""
+        state = None
+        if self._state_sent != self.steps:
+            state, self._state_sent = self._moving_state(), self.steps
+        return self.ray_helper.cast(state, key, directions, near, far, position, rotation)
+
+    def cast_answer(self, ticket, wait=False):
+        """The answer to :meth:`cast_later` as :meth:`ray_batch` gives it, or None while it is not back."""
+        return self.ray_helper.answer(ticket, wait)
+
+    def cast_drop(self, ticket):
+        """Throw away the answer to a cast nobody wants any more."""
+        self.ray_helper.drop(ticket)
+
+    def _moving_state(self):
+        """{body: (position, orientation, ((joint, position), ...))} of every robot and world body (PyBullet's
+        base frame): what the mirror must match before it casts."""
+        c = self.client
+        state = {}
+        for robot in self.robots:
+            body = robot.body
+            joints = self._movable.get(body)
+            if joints is None:
+                joints = self._movable[body] = [
+                    j for j in range(pybullet.getNumJoints(body, physicsClientId=c))
+                    if pybullet.getJointInfo(body, j, physicsClientId=c)[2] in (pybullet.JOINT_REVOLUTE,
+                                                                                pybullet.JOINT_PRISMATIC)]
+            values = [s[0] for s in pybullet.getJointStates(body, joints, physicsClientId=c)] if joints else []
+            state[body] = (*pybullet.getBasePositionAndOrientation(body, physicsClientId=c), tuple(zip(joints, values)))
+        for uid in [u for u, _ in self.world_bodies] + self._boxes:
+            state[uid] = (*pybullet.getBasePositionAndOrientation(uid, physicsClientId=c), ())
+        return state
 
     def retro(self, bodies, links):
         """Gazebo ``laser_retro`` of each hit (body, link) (0 where none is given, and for misses)."""
@@ -277,6 +332,7 @@ class World:
 
     def step(self):
         pybullet.stepSimulation(physicsClientId=self.client)
+        self.steps += 1
         if self.landing:
             self._watch_landings()
 
@@ -337,6 +393,8 @@ class World:
         if self.plane is not None:  # recreate our plane so that the plugin draws it
             pybullet.removeBody(self.plane, physicsClientId=self.client)
             self.plane = pybullet.loadURDF("plane.urdf", physicsClientId=self.client)
+            if self.ray_helper is not None:
+                self.ray_helper.plane(self.plane)
         return None
 
     # -- the world API (gazebo_ros's /gazebo services): move, remove, push ------------------------------
@@ -345,14 +403,20 @@ class World:
         pybullet.removeBody(robot.body, physicsClientId=self.client)
         self.robots.remove(robot)
         self.landing.pop(robot, None)
+        self._movable.pop(robot.body, None)
         for key in [k for k in self.laser_retro if k[0] == robot.body]:
             del self.laser_retro[key]
+        if self.ray_helper is not None:
+            self.ray_helper.remove(robot.body)
 
     def remove_body(self, uid):
         """Delete one world body (delete_model of a world model)."""
         pybullet.removeBody(uid, physicsClientId=self.client)
         self.world_bodies = [(u, b) for u, b in self.world_bodies if u != uid]
+        self._boxes = [u for u in self._boxes if u != uid]
         self.laser_retro.pop((uid, -1), None)
+        if self.ray_helper is not None:
+            self.ray_helper.remove(uid)
 
     def body_motion(self, uid, inertial_pose):
         """World body ``uid``'s link frame: (pose, linear velocity of its origin, angular velocity), world
@@ -414,6 +478,9 @@ class World:
         pybullet.performCollisionDetection(physicsClientId=c)
 
     def close(self):
+        if self.ray_helper is not None:
+            self.ray_helper.close()
+            self.ray_helper = None
         if self.client is not None and pybullet.isConnected(self.client):
             pybullet.disconnect(self.client)
         self.client = None
@@ -432,7 +499,11 @@ class World:
                                               physicsClientId=c)
         visual = pybullet.createVisualShape(pybullet.GEOM_BOX, halfExtents=[v / 2.0 for v in size],
                                             rgbaColor=(0.85, 0.6, 0.45, 1.0), physicsClientId=c)
-        return pybullet.createMultiBody(0.0, shape, visual, pose[0], pose[1], physicsClientId=c)
+        uid = pybullet.createMultiBody(0.0, shape, visual, pose[0], pose[1], physicsClientId=c)
+        self._boxes.append(uid)
+        if self.ray_helper is not None:
+            self.ray_helper.replay("add_kinematic_box", (size, pose), [uid])
+        return uid
 
     def move_body(self, uid, pose):
         """Place body ``uid`` (its base frame) at ``pose``."""

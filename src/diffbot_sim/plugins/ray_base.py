@@ -7,11 +7,16 @@ What the rays measure (angles, misses, noise, intensities) is :mod:`diffbot_sim.
 ``World.ray_batch``. A sensor on a link lumped into its parent by a fixed joint sits at that link's frame and
 its own ``<pose>`` is dropped, as sdformat's URDF reader replaces it (with a warning when it was not zero).
 """
+import itertools
+
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ConfigError
 from diffbot_sim.plugins.base import Plugin, summary_key
 from diffbot_sim.sensors import ray as ray_sensor
 from diffbot_sim.values import check_string
+
+#: Keys of the ray sensors' rays in the ray process (``World.cast_later``), one per sensor ever made.
+_RAY_KEYS = itertools.count()
 
 
 def plugin_tags(element):
@@ -65,25 +70,66 @@ class RaySensorPlugin(Plugin):
         self.processor = ray_sensor.ScanProcessor(cfg, rng)
         self.period = 1.0 / cfg.update_rate if cfg.update_rate > 0 else 0.0
         self.pub = None
+        self._ray_key = next(_RAY_KEYS)  # names this sensor's rays to the ray process
+        self._waiting = None  # (ticket, sim time, stamp) of a cast the ray process has not answered yet
+        self._answer = None  # its answer, for the publish() it is handed to
 
     def publishers(self):
         return [self.pub] if self.pub is not None else []
 
+    def _pose(self):
+        """World (position, rotation) of the sensor now."""
+        return ray_sensor.sensor_pose(*self.ctx.robot.link_pose(self.link), self.pose)
+
     def cast(self):
-        """(hit fractions, retro values) of this sensor's rays from its current pose."""
-        cfg = self.cfg
-        position, quaternion = self.ctx.robot.link_pose(self.link)
-        origin, rotation = ray_sensor.sensor_pose(position, quaternion, self.pose)
-        starts, ends = ray_sensor.world_rays(origin, rotation, self.directions, cfg.range_min, cfg.range_max)
+        """(hit fractions, retro values) of this sensor's rays from its current pose: the answer the ray
+        process gave for this step when there is one (``~ray_process``), else cast now."""
         world = self.ctx.sim.world
-        fractions, bodies, links = world.ray_batch(starts, ends)
+        if self._answer is not None:
+            fractions, bodies, links = self._answer
+            self._answer = None
+        else:
+            cfg = self.cfg
+            fractions, bodies, links = world.ray_batch(*ray_sensor.world_rays(*self._pose(), self.directions,
+                                                                             cfg.range_min, cfg.range_max))
         return fractions, world.retro(bodies, links)
 
+    def _casts_later(self):
+        """Real time with ``~ray_process``: the rays go to the helper process and the message is published
+        when their answer is back (a step or two later in wall time, stamped with the step it was due)."""
+        return self.ctx.sim.world.ray_helper is not None and self.ctx.cfg.real_time
+
+    def next_publish(self):
+        return self._waiting[1] if self._waiting is not None else self.next
+
     def after_step(self, now, stamp, transforms):
+        if self._waiting is not None:
+            ticket, due, due_stamp = self._waiting
+            answer = self.ctx.sim.world.cast_answer(ticket, wait=not self._casts_later())
+            if answer is None:
+                return  # not back yet: the loop asks again next step (next_publish says it is due)
+            self._waiting, self._answer = None, answer
+            self.publish(due, due_stamp)
+            self._answer = None  # unused when publish() chose not to publish (a range sensor's throttle)
         if not self.take_due(now, self.period):
             return
         if self.pub is not None and self.pub.get_num_connections():  # lazy, as gazebo_ros
-            self.publish(now, stamp)
+            if self._casts_later():
+                ticket = self.ctx.sim.world.cast_later(self._ray_key, self.directions, self.cfg.range_min,
+                                                       self.cfg.range_max, *self._pose())
+                self._waiting = (ticket, now, stamp)
+            else:
+                self.publish(now, stamp)
+
+    def start(self, now):
+        super().start(now)
+        self.drop_waiting()
+
+    def drop_waiting(self):
+        """A cast still out belongs to the time before a reset or a deletion: its answer is thrown away."""
+        if self._waiting is not None:
+            self.ctx.sim.world.cast_drop(self._waiting[0])
+        self._waiting = self._answer = None
 
     def publish(self, now, stamp):
         raise NotImplementedError

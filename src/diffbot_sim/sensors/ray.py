@@ -24,7 +24,7 @@ import numpy as np
 
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ConfigError
-from diffbot_sim.transforms import quaternion_matrix, rpy_matrix
+from diffbot_sim.transforms import quaternion_matrix, rays_along, rpy_matrix
 from diffbot_sim.values import check_bool, check_number, tag_number
 
 
@@ -243,10 +243,7 @@ def sensor_pose(link_position, link_quaternion, pose):
 def world_rays(position, rotation, directions, range_min, range_max):
     """Start and end points (each (rays, 3), C-contiguous float64) of rays from ``range_min`` to
     ``range_max`` along ``directions`` (sensor frame) of a sensor at ``position``/``rotation``."""
-    world = directions @ rotation.T
-    starts = position + world * range_min
-    ends = position + world * range_max
-    return np.ascontiguousarray(starts), np.ascontiguousarray(ends)
+    return rays_along(position, rotation, directions, range_min, range_max)
 
 
 def raw_ranges(fractions, range_min, range_max):

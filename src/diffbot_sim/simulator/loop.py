@@ -163,7 +163,7 @@ class Simulator:
         self._requests = []
         self._requests_lock = threading.Lock()
         self.steps = 0
-        self.world = World(cfg.time_step, cfg.gravity, gui=cfg.gui)
+        self.world = World(cfg.time_step, cfg.gravity, gui=cfg.gui, ray_process=cfg.ray_process)
         self.clock_pub = publisher("/clock", Clock)
         self.tf_pub = publisher("/tf", TFMessage)
         self.robots = []
