@@ -393,3 +393,25 @@ def test_seed_and_renderer_are_validated_once(params, ok):
         with pytest.raises(ConfigError) as err:
             sim_config(params)
         assert f"~{next(iter(params))}" in str(err.value)
+
+
+@pytest.mark.parametrize("value,expected", [(None, "auto"), ("auto", "auto"), (" AUTO ", "auto"), (True, True),
+                                            ("true", True), ("false", False), (0, False)])
+def test_ray_process_setting(value, expected):
+    cfg = sim_config({} if value is None else {"ray_process": value})
+    assert cfg.ray_process == expected
+
+
+def test_bad_ray_process_setting_names_the_parameter_and_the_choices():
+    with pytest.raises(ConfigError, match=r"~ray_process.*true, false or auto"):
+        sim_config({"ray_process": "sometimes"})
+
+
+def test_ray_process_wanted_in_real_time_above_the_auto_threshold():
+    from diffbot_sim.config import RAY_PROCESS_AUTO_RAYS, wants_ray_process
+    many, few = RAY_PROCESS_AUTO_RAYS, RAY_PROCESS_AUTO_RAYS - 1
+    assert wants_ray_process("auto", True, many)
+    assert not wants_ray_process("auto", True, few)
+    assert not wants_ray_process("auto", False, many)  # fast mode casts in place: it waits for every message
+    assert wants_ray_process(True, False, 0)
+    assert not wants_ray_process(False, True, many)

@@ -40,6 +40,8 @@ class World:
     Args:
         gui: open PyBullet's window (the caller checks a display exists).
         time_step: s. gravity: m/s^2 along z.
+        ray_process: True starts the ray process (:meth:`cast_later`) now, "later" keeps what it needs to start
+            it with :meth:`start_ray_process`, False never starts one.
     """
 
     def __init__(self, time_step, gravity=-9.81, gui=False, ray_process=False):
@@ -59,12 +61,13 @@ class World:
         self._boxes = []  # add_kinematic_box's bodies
         self._movable = {}  # body -> its revolute and prismatic joints' indices (the mirror's state)
         self._state_sent = None  # self.steps when the mirror was last sent the state
+        self.ray_helper = None  # the ray process (physics.ray_process.RayProcess), once started
+        # What the ray process must replay to build this world, kept until it starts ("later"); None: never
+        self._journal = [] if ray_process in (True, "later") else None
         self._setup()
-        self.ray_helper = None
-        if ray_process:
-            from diffbot_sim.physics.ray_process import RayProcess
-            self.ray_helper = RayProcess(time_step, gravity)
-            self.ray_helper.plane(self.plane)
+        self._mirror("plane", self.plane)
+        if ray_process is True:
+            self.start_ray_process()
 
     def _setup(self):
         c = self.client
@@ -103,8 +106,7 @@ class World:
         self.robots.append(robot)
         self.lift_out(robot)
         self.laser_retro.update(robot.laser_retro())
-        if self.ray_helper is not None:
-            self.ray_helper.replay("load_robot", (urdf_text, model, position, yaw, orientation), [body])
+        self._mirror("replay", "load_robot", (urdf_text, model, position, yaw, orientation), [body])
         return robot
 
     def load_world(self, world, mesh_cache):
@@ -154,9 +156,8 @@ class World:
             if body.shapes[0].surface.get("laser_retro"):
                 self.laser_retro[(uid, -1)] = float(body.shapes[0].surface["laser_retro"])
             built += 1
-        if self.ray_helper is not None:
-            self.ray_helper.replay("load_world", (world, mesh_cache), [uid for uid, _ in self.world_bodies[before:]])
-            self.ray_helper.plane(self.plane)
+        self._mirror("replay", "load_world", (world, mesh_cache), [uid for uid, _ in self.world_bodies[before:]])
+        self._mirror("plane", self.plane)
         return built
 
     def _compound(self, shapes, static, mesh_cache):
@@ -283,6 +284,23 @@ class World:
         return fractions, bodies, links
 
     # -- rays cast in the helper process (``ray_process``): the same answers, later in wall time ----------------
+    def _mirror(self, request, *args):
+        """A change of the world's bodies, for the ray process: sent now, kept for when it starts, or dropped."""
+        if self.ray_helper is not None:
+            getattr(self.ray_helper, request)(*args)
+        elif self._journal is not None:
+            self._journal.append((request, args))
+
+    def start_ray_process(self):
+        """Start the ray process (``World(ray_process="later")``: it is built from every change made so far)."""
+        if self.ray_helper is not None:
+            return
+        from diffbot_sim.physics.ray_process import RayProcess
+        helper = RayProcess(self.time_step, self.gravity)
+        for request, args in self._journal or ():
+            getattr(helper, request)(*args)
+        self.ray_helper, self._journal = helper, None
+
     def cast_later(self, key, directions, near, far, position, rotation):
         """Hand a ray sensor's rays to the ray process: ``directions`` ((N, 3), its frame; sent once per ``key``,
         again only when a different array is given) from ``near`` to ``far`` [m], the sensor at ``position``
@@ -393,8 +411,7 @@ class World:
         if self.plane is not None:  # recreate our plane so that the plugin draws it
             pybullet.removeBody(self.plane, physicsClientId=self.client)
             self.plane = pybullet.loadURDF("plane.urdf", physicsClientId=self.client)
-            if self.ray_helper is not None:
-                self.ray_helper.plane(self.plane)
+            self._mirror("plane", self.plane)
         return None
 
     # -- the world API (gazebo_ros's /gazebo services): move, remove, push ------------------------------
@@ -406,8 +423,7 @@ class World:
         self._movable.pop(robot.body, None)
         for key in [k for k in self.laser_retro if k[0] == robot.body]:
             del self.laser_retro[key]
-        if self.ray_helper is not None:
-            self.ray_helper.remove(robot.body)
+        self._mirror("remove", robot.body)
 
     def remove_body(self, uid):
         """Delete one world body (delete_model of a world model)."""
@@ -415,8 +431,7 @@ class World:
         self.world_bodies = [(u, b) for u, b in self.world_bodies if u != uid]
         self._boxes = [u for u in self._boxes if u != uid]
         self.laser_retro.pop((uid, -1), None)
-        if self.ray_helper is not None:
-            self.ray_helper.remove(uid)
+        self._mirror("remove", uid)
 
     def body_motion(self, uid, inertial_pose):
         """World body ``uid``'s link frame: (pose, linear velocity of its origin, angular velocity), world
@@ -501,8 +516,7 @@ class World:
                                             rgbaColor=(0.85, 0.6, 0.45, 1.0), physicsClientId=c)
         uid = pybullet.createMultiBody(0.0, shape, visual, pose[0], pose[1], physicsClientId=c)
         self._boxes.append(uid)
-        if self.ray_helper is not None:
-            self.ray_helper.replay("add_kinematic_box", (size, pose), [uid])
+        self._mirror("replay", "add_kinematic_box", (size, pose), [uid])
         return uid
 
     def move_body(self, uid, pose):

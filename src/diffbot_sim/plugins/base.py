@@ -203,6 +203,10 @@ class Plugin:
         """Sim time at which ``before_step`` has work (control); inf: only when a command arrives."""
         return math.inf
 
+    def rays_per_second(self):
+        """Rays this plugin casts per sim second (ray sensors; ``~ray_process: auto`` counts them)."""
+        return 0.0
+
     def next_publish(self):
         """Sim time at which ``after_step`` has work (publishing): the next scheduled publication
         (``self.next``, which ``take_due`` moves on). A plugin that publishes nothing returns inf."""

@@ -77,6 +77,10 @@ class RaySensorPlugin(Plugin):
     def publishers(self):
         return [self.pub] if self.pub is not None else []
 
+    def rays_per_second(self):
+        rate = self.cfg.update_rate if self.cfg.update_rate > 0 else 1.0 / self.ctx.cfg.time_step
+        return self.cfg.rays * rate
+
     def _pose(self):
         """World (position, rotation) of the sensor now."""
         return ray_sensor.sensor_pose(*self.ctx.robot.link_pose(self.link), self.pose)

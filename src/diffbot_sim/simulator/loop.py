@@ -12,6 +12,7 @@ from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
+from diffbot_sim.config import wants_ray_process
 from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.physics import World
 from diffbot_sim.plugins.base import next_due, publisher
@@ -163,7 +164,8 @@ class Simulator:
         self._requests = []
         self._requests_lock = threading.Lock()
         self.steps = 0
-        self.world = World(cfg.time_step, cfg.gravity, gui=cfg.gui, ray_process=cfg.ray_process)
+        self.world = World(cfg.time_step, cfg.gravity, gui=cfg.gui,
+                           ray_process="later" if cfg.ray_process == "auto" else cfg.ray_process)
         self.clock_pub = publisher("/clock", Clock)
         self.tf_pub = publisher("/tf", TFMessage)
         self.robots = []
@@ -285,6 +287,7 @@ class Simulator:
         """A robot joins the loop; one spawned while running starts at the current sim time."""
         self.robots.append(runtime)
         self._sensor_pubs = None
+        self.consider_ray_process()
         if now is not None:
             runtime.start(now)
             self._next_publish = min(self._next_publish, now)
@@ -303,6 +306,18 @@ class Simulator:
         else:
             self.cfg.real_time = False
         self._rebase()
+        self.consider_ray_process()
+
+    def consider_ray_process(self):
+        """Start the ray process when ``~ray_process`` wants it now (``config.wants_ray_process``: auto counts
+        the ray sensors' rays per sim second, in real time)."""
+        if self.cfg.ray_process != "auto" or self.world.ray_helper is not None:
+            return
+        rays = sum(plugin.rays_per_second() for runtime in self.robots for plugin in runtime.plugins)
+        if wants_ray_process(self.cfg.ray_process, self.cfg.real_time, rays):
+            self.world.start_ray_process()
+            rospy.loginfo(f"bullet_sim: the ray sensors cast {rays:,.0f} rays per sim second: casting them in a "
+                          "helper process from now on (~ray_process auto; false casts them in this one)")
 
     @property
     def sim_time(self):

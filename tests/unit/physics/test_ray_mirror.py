@@ -161,3 +161,35 @@ def test_close_ends_the_ray_process():
     process = w.ray_helper.process
     w.close()
     assert process.poll() is not None
+
+
+def test_a_ray_process_started_later_is_built_from_everything_before(seed_urdf, tmp_path):
+    w = World(DT, ray_process="later")
+    try:
+        w.load_world(house(tmp_path), str(tmp_path / "cache"))
+        model = parse_urdf(seed_urdf, "seed")
+        robots = [w.load_robot(seed_urdf, model, (x, 0.0, 0.0)) for x in (-1.0, 0.0, 1.0)]
+        w.remove_robot(robots[0])
+        box = w.add_kinematic_box((0.5, 0.3, 1.7), ((0.0, -1.5, 0.85), (0, 0, 0, 1)))
+        assert w.ray_helper is None
+        for _ in range(60):
+            w.step()
+        w.start_ray_process()
+        _, bodies, _ = assert_same(w, *rays_around(EYE))
+        # PyBullet gives the box the removed robot's id: the mirror names it so too
+        assert robots[1].body in bodies and robots[2].body in bodies and box in bodies
+        w.move_body(box, ((0.5, -1.0, 0.85), (0, 0, 0, 1)))
+        w.step()
+        _, bodies, _ = assert_same(w, *rays_around(EYE))
+        assert box in bodies
+    finally:
+        w.close()
+
+
+def test_no_journal_without_a_ray_process_to_come(seed_urdf):
+    w = World(DT)
+    try:
+        w.load_robot(seed_urdf, parse_urdf(seed_urdf, "seed"))
+        assert w._journal is None and w.ray_helper is None
+    finally:
+        w.close()
