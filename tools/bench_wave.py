@@ -250,7 +250,8 @@ def fleet_launch(count, model, rsp, ray_process=None):
     for robot in robots if rsp else ():
         inc = ET.SubElement(root, "include", file=os.path.join(ROOT, "launch", "robot_state.launch"), ns=robot["name"])
         ET.SubElement(inc, "arg", name="tf_prefix", value=robot["name"])
-    path = os.path.join(RESULTS, f"fleet_{count}{'_rsp' if rsp else ''}{'' if ray_process is None else f'_rp_{ray_process}'}.launch")
+    variant = ("_rsp" if rsp else "") + ("" if ray_process is None else f"_rp_{ray_process}")
+    path = os.path.join(RESULTS, f"fleet_{count}{variant}.launch")
     ET.ElementTree(root).write(path)
     return path
 
@@ -400,8 +401,8 @@ def bench_fleet(seconds):
         out[key]["bare_robots_at_real_time"] = round(statistics.median([count * p["bare_rtf"] for p in runs]), 1)
         out[key]["ratio_to_bare"] = round(statistics.median([p["ratio"] for p in runs]), 3)
     physics = {n: bare_fleet(n, 5.0, laser_model, False) for n in (40, 60)}
-    out.update({"pairs": pairs, "bare_physics_only_rtf": physics,
-                "bare_physics_only_robots_at_real_time": round(statistics.median([n * r for n, r in physics.items()]), 1)})
+    physics_count = round(statistics.median([n * r for n, r in physics.items()]), 1)
+    out.update({"pairs": pairs, "bare_physics_only_rtf": physics, "bare_physics_only_robots_at_real_time": physics_count})
     return out
 
 

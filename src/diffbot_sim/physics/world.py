@@ -285,10 +285,18 @@ class World:
 
     # -- rays cast in the helper process (``ray_process``): the same answers, later in wall time ----------------
     def _mirror(self, request, *args):
-        """A change of the world's bodies, for the ray process: sent now, kept for when it starts, or dropped."""
+        """A change of the world's bodies, for the ray process: sent now, kept for when it starts, or dropped.
+        A kept body that is removed again leaves the journal (a fast-mode run that spawns and deletes models for
+        hours keeps nothing of them)."""
         if self.ray_helper is not None:
             getattr(self.ray_helper, request)(*args)
         elif self._journal is not None:
+            if request == "remove":
+                made = [k for k, (kind, entry) in enumerate(self._journal)
+                        if kind == "replay" and entry[2] == [args[0]]]
+                if made:
+                    del self._journal[made[-1]]
+                    return
             self._journal.append((request, args))
 
     def start_ray_process(self):

@@ -193,3 +193,20 @@ def test_no_journal_without_a_ray_process_to_come(seed_urdf):
         assert w._journal is None and w.ray_helper is None
     finally:
         w.close()
+
+
+def test_a_body_removed_before_the_ray_process_starts_leaves_its_journal(seed_urdf):
+    w = World(DT, ray_process="later")
+    try:
+        model = parse_urdf(seed_urdf, "seed")
+        for _ in range(5):
+            w.remove_robot(w.load_robot(seed_urdf, model, (1.0, 0.0, 0.0)))
+            w.remove_body(w.add_kinematic_box((0.2, 0.2, 0.2), ((0.0, 1.0, 0.1), (0, 0, 0, 1))))
+        assert [kind for kind, _ in w._journal] == ["plane"]
+        kept = w.load_robot(seed_urdf, model, (1.0, 0.0, 0.0))
+        w.step()
+        w.start_ray_process()
+        _, bodies, _ = assert_same(w, *rays_around(EYE))
+        assert kept.body in bodies
+    finally:
+        w.close()
