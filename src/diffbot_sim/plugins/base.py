@@ -230,6 +230,9 @@ class Plugin:
     def reset(self, now):
         """Brake and forget pending commands (reset_simulation)."""
 
+    def close(self):
+        """The robot is deleted: give back what the plugin holds outside ROS (its topics go with the context)."""
+
     def summary(self):
         """Effective settings for the start-up report: {name: value}."""
         return {}

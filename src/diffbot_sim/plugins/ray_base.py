@@ -129,6 +129,9 @@ class RaySensorPlugin(Plugin):
         super().start(now)
         self.drop_waiting()
 
+    def close(self):
+        self.drop_waiting()
+
     def drop_waiting(self):
         """A cast still out belongs to the time before a reset or a deletion: its answer is thrown away."""
         if self._waiting is not None:

@@ -118,7 +118,9 @@ class RobotRuntime:
         self.plugins = plugins
 
     def close(self):
-        """Remove every topic and service of its plugins (delete_model)."""
+        """Remove every topic and service of its plugins (delete_model), and what they hold besides."""
+        for plugin in self.plugins:
+            plugin.close()
         self.ctx.close()
 
     def publishers(self):

@@ -3,6 +3,7 @@
 whose face is 2.85 m ahead of the sensor: every point lies on that face, rings number the rows from the
 lowest, min_range/max_range clip, an organised cloud keeps NaN where nothing returned."""
 import os
+import time
 import xml.etree.ElementTree as ET
 
 import genpy
@@ -59,7 +60,7 @@ def make(scene, plugin_xml, create):
     ctx = RobotContext(type("Sim", (), {"world": world})(), sim_config({}), spec, model, robot, {}, None, "~")
     plugin = create(ctx, sensor, element.find("plugin"), {})
     plugin.after_step(0.0, genpy.Time(0, 0), [])
-    return plugin, plugin.pub.sent[-1]
+    return plugin, plugin.pub.sent[-1] if plugin.pub.sent else None
 
 
 def cloud(msg):
@@ -98,3 +99,44 @@ def test_block_laser_point_cloud(scene):
     assert plugin.pub.resolved_name == "/cloud" and len(msg.points) == 24
     np.testing.assert_allclose([p.x for p in msg.points], FACE, atol=0.01)
     assert msg.channels[0].name == "" and set(msg.channels[0].values) == {100.0}
+
+
+def test_in_the_ray_process_a_scan_is_published_when_its_answer_is_back(monkeypatch):
+    """~ray_process in real time: the due step only hands the rays over; a later step publishes the cloud,
+    stamped with the due step and equal to the one cast in place; a deleted robot's cast is dropped."""
+    monkeypatch.setattr(base, "publisher", _Pub)
+    world = World(1.0 / 240.0, ray_process=True)
+    try:
+        wall = Body("east", "east", ((3.0, 0.0, 0.5), (0, 0, 0, 1)), True,
+                    [Shape("box", (0.2, 6.0, 1.0), surface={"laser_retro": 100.0})])
+        world.load_world(WorldDescription("w", "test", [wall]), "/nonexistent")
+        plugin, _ = make((world, *_robot(world)), VELODYNE, ray_clouds.create_velodyne)
+        assert plugin.pub.sent == [] and plugin.next_publish() == 0.0  # handed over; due again next step
+        step, deadline = 0, time.monotonic() + 20.0  # the helper's start (PyBullet's import) is most of it
+        while not plugin.pub.sent and time.monotonic() < deadline:
+            step += 1
+            world.step()
+            plugin.after_step(step / 240.0, genpy.Time.from_sec(step / 240.0), [])
+            time.sleep(0.004)  # a real-time step
+        msg = plugin.pub.sent[0]
+        assert msg.header.stamp == genpy.Time(0, 0)  # as of the step it was due, published later
+        pts = cloud(msg)
+        assert len(pts) == 24
+        np.testing.assert_allclose(pts["x"], FACE, atol=0.01)
+        assert np.all(pts["intensity"] == 100.0)  # the wall's laser_retro: hits named by the simulator's ids
+        if plugin._waiting is None:  # the next scan was due already when the first came back: handed over then
+            plugin.after_step(1.0, genpy.Time.from_sec(1.0), [])
+        ticket = plugin._waiting[0]
+        plugin.close()
+        assert plugin._waiting is None and ticket not in world.ray_helper._waiting
+    finally:
+        world.close()
+
+
+VELODYNE = '<plugin name="v" filename="libgazebo_ros_velodyne_laser.so"><frameName>laser_link</frameName></plugin>'
+
+
+def _robot(world):
+    text = open(LASER_URDF).read()
+    model = parse_urdf(text, LASER_URDF)
+    return world.load_robot(text, model), model

@@ -145,6 +145,9 @@ class Plugin:
     def start(self, now):
         self.calls.append((self.name, "start", now))
 
+    def close(self):
+        self.calls.append((self.name, "close", None))
+
 
 class Context:
     closed = False
@@ -183,5 +186,5 @@ def test_every_plugin_is_called_in_order_and_close_goes_to_the_context():
                      ("a", "after", 0.002), ("b", "after", 0.002), ("a", "reset", 0.003), ("b", "reset", 0.003)]
     assert transforms == ["a", "b"]  # one list for the step's TF message
     runtime.close()
-    assert ctx.closed
+    assert calls[-2:] == [("a", "close", None), ("b", "close", None)] and ctx.closed
 
