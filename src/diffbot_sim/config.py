@@ -56,8 +56,8 @@ class SimConfig:
     enable_ros_network: bool = True  # false: no /gazebo services or topics (gazebo_ros's parameter)
     gazebo_namespace: str = "/gazebo"  # where the gazebo_ros world API lives (spawn_model -gazebo_namespace)
     physics_engine: str = "ode"  # what the world launch asked for; the engine is always Bullet (noted)
-    ray_process: object = "auto"  # real time: ray sensors cast in a helper process: true, false or auto (above
-    # RAY_PROCESS_AUTO_RAYS rays per sim second)
+    ray_process: object = False  # real time: ray sensors cast in a helper process: true, false or auto (from
+    # RAY_PROCESS_AUTO_RAYS rays per sim second on); off by default: docs/fleet.md, "The ray process"
 
 
 @dataclass

@@ -395,7 +395,7 @@ def test_seed_and_renderer_are_validated_once(params, ok):
         assert f"~{next(iter(params))}" in str(err.value)
 
 
-@pytest.mark.parametrize("value,expected", [(None, "auto"), ("auto", "auto"), (" AUTO ", "auto"), (True, True),
+@pytest.mark.parametrize("value,expected", [(None, False), ("auto", "auto"), (" AUTO ", "auto"), (True, True),
                                             ("true", True), ("false", False), (0, False)])
 def test_ray_process_setting(value, expected):
     cfg = sim_config({} if value is None else {"ray_process": value})
