@@ -59,7 +59,6 @@ class World:
         self.ray_threads = 0  # rayTestBatch's numThreads (0: Bullet's pool picks)
         self.steps = 0  # physics steps taken
         self._boxes = []  # add_kinematic_box's bodies
-        self._movable = {}  # body -> its revolute and prismatic joints' indices (the mirror's state)
         self._state_sent = None  # self.steps when the mirror was last sent the state
         self.ray_helper = None  # the ray process (physics.ray_process.RayProcess), once started
         # What the ray process must replay to build this world, kept until it starts ("later"); None: never
@@ -334,15 +333,10 @@ class World:
         c = self.client
         state = {}
         for robot in self.robots:
-            body = robot.body
-            joints = self._movable.get(body)
-            if joints is None:
-                joints = self._movable[body] = [
-                    j for j in range(pybullet.getNumJoints(body, physicsClientId=c))
-                    if pybullet.getJointInfo(body, j, physicsClientId=c)[2] in (pybullet.JOINT_REVOLUTE,
-                                                                                pybullet.JOINT_PRISMATIC)]
-            values = [s[0] for s in pybullet.getJointStates(body, joints, physicsClientId=c)] if joints else []
-            state[body] = (*pybullet.getBasePositionAndOrientation(body, physicsClientId=c), tuple(zip(joints, values)))
+            joints = sorted(robot.joint_index.values())
+            positions = robot.joint_states(joints)[0] if joints else []
+            state[robot.body] = (*pybullet.getBasePositionAndOrientation(robot.body, physicsClientId=c),
+                                 tuple(zip(joints, positions)))
         for uid in [u for u, _ in self.world_bodies] + self._boxes:
             state[uid] = (*pybullet.getBasePositionAndOrientation(uid, physicsClientId=c), ())
         return state
@@ -428,7 +422,6 @@ class World:
         pybullet.removeBody(robot.body, physicsClientId=self.client)
         self.robots.remove(robot)
         self.landing.pop(robot, None)
-        self._movable.pop(robot.body, None)
         for key in [k for k in self.laser_retro if k[0] == robot.body]:
             del self.laser_retro[key]
         self._mirror("remove", robot.body)
