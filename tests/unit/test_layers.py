@@ -18,8 +18,9 @@ PACKAGE = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.a
 LAYERS = {
     # the exception hierarchy every layer raises
     "errors": 0,
-    # what everything shares: checked values, rotations and poses, the process's output streams
-    "values": 1, "transforms": 1, "streams": 1,
+    # what everything shares: checked values, rotations and poses, the process's output streams, waiting with
+    # a deadline
+    "values": 1, "transforms": 1, "streams": 1, "waiting": 1,
     # descriptions read into data, the controllers' and the teleop's mathematics, the validated config
     "config": 2, "description": 2, "control": 2, "teleop": 2,
     # worlds (they name packages through description) and sensor models (they read description's tags)
