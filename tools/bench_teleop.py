@@ -28,6 +28,8 @@ import threading
 import time
 import xmlrpc.client
 
+from diffbot_sim.waiting import wait_for
+
 PKG = "diffbot_sim"
 NODE = "teleop_key_bench"
 
@@ -36,14 +38,6 @@ def free_port():
     with socket.socket() as sock:
         sock.bind(("localhost", 0))
         return sock.getsockname()[1]
-
-
-def wait_for(predicate, timeout, what):
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise RuntimeError(f"timed out after {timeout} s waiting for {what}")
-        time.sleep(0.005)
 
 
 def cpu_seconds(pid):
@@ -102,7 +96,7 @@ def main():
         from geometry_msgs.msg import Twist
         from nav_msgs.msg import Odometry
 
-        wait_for(lambda: rosgraph.is_master_online(), 30.0, "roscore")
+        wait_for(lambda: rosgraph.is_master_online(), 30.0, "roscore", 0.005)
         rospy.init_node("bench_teleop", disable_signals=True)
         received = []
         rospy.Subscriber("/cmd_vel", Twist, lambda msg: received.append(time.monotonic()))
@@ -113,7 +107,7 @@ def main():
         drain.start()
         teleop = subprocess.Popen(["rosrun", PKG, "teleop_key", f"__name:={NODE}"], stdin=slave, stdout=slave,
                                   stderr=slave, start_new_session=True, close_fds=True)
-        wait_for(lambda: b"we are ready" in drain.data, 60.0, "the teleop banner")
+        wait_for(lambda: b"we are ready" in drain.data, 60.0, "the teleop banner", 0.005)
         me = rospy.get_name()
 
         def connected():
@@ -124,14 +118,14 @@ def main():
                 return False
             return any(c[2] == "o" and c[4] == "/cmd_vel" and c[1] == me for c in info)
 
-        wait_for(connected, 60.0, "the teleop's cmd_vel connection")
+        wait_for(connected, 60.0, "the teleop's cmd_vel connection", 0.005)
 
         latencies = []
         for n in range(args.keys):
             count = len(received)
             typed = time.monotonic()
             os.write(master, b"i" if n % 2 == 0 else b"k")
-            wait_for(lambda: len(received) > count, 5.0, f"the Twist of key {n}")
+            wait_for(lambda: len(received) > count, 5.0, f"the Twist of key {n}", 0.005)
             latencies.append(received[count] - typed)
             time.sleep(args.gap)
         os.write(master, b"s")

@@ -28,6 +28,8 @@ CAMERA_ROBOT = os.path.join(ROOT, "tests", "data", "robots", "camera_robot.urdf"
 PLAIN_ROBOT = os.path.join(ROOT, "tests", "data", "robots", "fixed_caster.urdf")
 W, H, HFOV, NEAR, FAR = 640, 480, 1.047, 0.05, 20.0
 
+from diffbot_sim.waiting import wait_for  # noqa: E402  (src/ on the path first)
+
 
 def robot_640(path):
     """camera_robot.urdf with its front camera at 640x480, 30 Hz (the depth camera stays, unsubscribed)."""
@@ -119,15 +121,13 @@ def cpu_seconds(pid):
 def wait_topic(topic, timeout=60.0):
     import rosgraph
     master = rosgraph.Master("/camera_speed")
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
+
+    def published():
         try:
-            if any(name == topic for name, _ in master.getPublishedTopics("")):
-                return
-        except OSError:
-            pass
-        time.sleep(0.2)
-    raise RuntimeError(f"timed out waiting for {topic}")
+            return any(name == topic for name, _ in master.getPublishedTopics(""))
+        except OSError:  # the master is not up yet
+            return False
+    wait_for(published, timeout, f"a publisher of {topic}", 0.2)
 
 
 def node_trial(model, seconds, subscribe, real_time):

@@ -31,6 +31,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "src"))
 
 from diffbot_sim.view import xscreen  # noqa: E402
+from diffbot_sim.waiting import wait_for  # noqa: E402
 
 DOCS = os.path.join(ROOT, "docs")
 ROBOT = os.path.join(ROOT, "tests", "data", "robots", "view_robot.urdf")
@@ -106,7 +107,7 @@ def first_frame(display, args, log):
     def ready():
         launch.check()
         return robot_drawn(display)
-    xscreen.wait_for(ready, 120, "the first rviz frame with the robot", period=0.05)
+    wait_for(ready, 120, "the first rviz frame with the robot", 0.05)
     return launch, time.monotonic() - launch.started
 
 
@@ -127,9 +128,9 @@ def pybullet_frame(display, launch):
             return master.hasParam("/bullet_sim/world_bodies")
         except Exception:  # the master is not up yet
             return False
-    window = xscreen.wait_for(lambda: launch.check() or xscreen.find_window(display, "Bullet Physics"), 60,
-                              "PyBullet's window")
-    xscreen.wait_for(built, 60, "the simulator to load the world and the robot (/bullet_sim/world_bodies)")
+    window = wait_for(lambda: launch.check() or xscreen.find_window(display, "Bullet Physics"), 60,
+                      "PyBullet's window", 0.1)
+    wait_for(built, 60, "the simulator to load the world and the robot (/bullet_sim/world_bodies)", 0.1)
     previous = [None]
 
     def settled():
@@ -139,7 +140,7 @@ def pybullet_frame(display, launch):
         same = previous[0] is not None and int(xscreen.changed(previous[0], scene).sum()) <= SETTLE_CHANGED
         previous[0] = scene
         return (frame,) if same and scene.std() > 20 else None
-    return xscreen.wait_for(settled, 60, "PyBullet to draw the scene (two equal frames)", SETTLE_PERIOD)[0]
+    return wait_for(settled, 60, "PyBullet to draw the scene (two equal frames)", SETTLE_PERIOD)[0]
 
 
 class Recorder:
@@ -168,7 +169,7 @@ class Recorder:
     def drive(self, plan):
         """``plan``: [(linear m/s, angular rad/s, sim seconds)], then a stop."""
         rospy = self.rospy
-        xscreen.wait_for(lambda: self.cmd.get_num_connections() > 0, 20, "the simulator to subscribe /cmd_vel")
+        wait_for(lambda: self.cmd.get_num_connections() > 0, 20, "the simulator to subscribe /cmd_vel")
         for linear, angular, seconds in plan:
             start = rospy.get_time()
             while rospy.get_time() - start < seconds:
@@ -321,7 +322,7 @@ def main():
         try:
             say("driving the scripted path (about 15 s)")
             recorder = Recorder(launch.env)
-            xscreen.wait_for(lambda: recorder.subs[0].get_num_connections() > 0, 20, "/odom to connect")
+            wait_for(lambda: recorder.subs[0].get_num_connections() > 0, 20, "/odom to connect")
             recorder.drive([(0.4, 0.0, 3.0), (0.0, 0.8, 2.0), (0.3, 0.0, 2.5), (0.3, -0.6, 4.0)])
             top, _ = rviz_view(x.display)
             xscreen.save_png(xscreen.crop(xscreen.screenshot(x.display), top.box()), os.path.join(DOCS, "rviz.png"),

@@ -18,6 +18,7 @@ from tf2_msgs.msg import TFMessage
 SIM = "/bullet_sim"
 #: m / rad: a driving body stays this close to its rest height, and tilts less than this (drive_check's bounds).
 from diffbot_sim.check.drive_check import HEIGHT_TOLERANCE, MAX_TILT  # noqa: E402
+from diffbot_sim import waiting  # noqa: E402
 
 
 def yaw_of(q):
@@ -40,16 +41,15 @@ def action_done(client):
     return handle is not None and handle.get_comm_state() == CommState.DONE
 
 
+def ros_shut_down():
+    """``wait_for``'s reason to give up early: this node's rospy has shut down (nothing more will arrive)."""
+    return rospy.is_shutdown() and "ROS shut down"
+
+
 def wait_for(predicate, timeout, what, poll=0.02):
-    """Poll ``predicate`` until it returns something true (returned) or ``timeout`` wall seconds pass
-    (AssertionError naming ``what``)."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline and not rospy.is_shutdown():
-        value = predicate()
-        if value:
-            return value
-        time.sleep(poll)
-    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+    """``diffbot_sim.waiting.wait_for`` as a test waits: poll ``predicate`` until it returns something true
+    (returned); fail (AssertionError naming ``what``) after ``timeout`` wall seconds or once ROS shuts down."""
+    return waiting.wait_for(predicate, timeout, what, poll, error=AssertionError, give_up=ros_shut_down)
 
 
 class Latest:
@@ -179,14 +179,8 @@ class Recorder:
                 del store[:]
 
     def wait(self, predicate, timeout, what):
-        """Poll ``predicate`` until true or ``timeout`` wall seconds pass; then raise AssertionError(what)."""
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline and not rospy.is_shutdown():
-            value = predicate()
-            if value:
-                return value
-            time.sleep(0.01)
-        raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+        """``wait_for``, polling every 10 ms."""
+        return wait_for(predicate, timeout, what, 0.01)
 
     def wait_connected(self, timeout=20.0):
         self.wait(lambda: self.cmd.get_num_connections() > 0, timeout, "the simulator to subscribe /cmd_vel")

@@ -18,6 +18,7 @@ from geometry_msgs.msg import Twist
 from laser_geometry import LaserProjection
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan, Range
+from simtest import wait_for
 
 SIM = "/bullet_sim"
 LASER_IN_FOOTPRINT = (0.05, 0.0, 0.113)  # base_footprint -> base_link 0.033 up, base_link -> laser (0.05, 0, 0.08)
@@ -106,13 +107,7 @@ class LaserTest(unittest.TestCase):
             del store[:-200]
 
     def wait(self, predicate, timeout, what):
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline and not rospy.is_shutdown():
-            value = predicate()
-            if value:
-                return value
-            time.sleep(0.01)
-        self.fail(f"timed out after {timeout} s waiting for {what}")
+        return wait_for(predicate, timeout, what, 0.01)
 
     def last(self, store):
         with self.lock:

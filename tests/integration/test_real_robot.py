@@ -22,7 +22,6 @@ diffbot_sim.check.drive_check, shared with `robot_check`.
 """
 import sys
 import threading
-import time
 import unittest
 
 import rospy
@@ -30,6 +29,7 @@ import rostest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu
+from simtest import wait_for
 from std_srvs.srv import Empty
 
 from diffbot_sim.check import drive_check
@@ -93,11 +93,7 @@ class RealRobotTest(unittest.TestCase):
             cls.subs.append(rospy.Subscriber(rospy.get_param("~imu_topic"), Imu, cls.imu, queue_size=1))
 
     def wait(self, predicate, timeout, what):
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            if time.monotonic() > deadline or rospy.is_shutdown():
-                self.fail(f"timed out after {timeout} s waiting for {what}")
-            time.sleep(0.005)
+        return wait_for(predicate, timeout, what, 0.005)
 
     def drive(self, linear, angular, seconds, lateral=0.0):
         """Command (linear, angular) at 20 Hz of sim time for ``seconds``; returns (odom, truth) at start and

@@ -17,6 +17,7 @@ import rostest
 from geometry_msgs.msg import Twist, Vector3Stamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, NavSatFix
+from simtest import wait_for
 
 from diffbot_sim.transforms import yaw_from_quaternion
 from diffbot_sim.plugins.gps import radii
@@ -68,11 +69,7 @@ class SensorImuTest(unittest.TestCase):
         cls.pub = rospy.Publisher("/cmd_vel", Twist, queue_size=1)
 
     def wait(self, predicate, timeout, what):
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            if time.monotonic() > deadline or rospy.is_shutdown():
-                self.fail(f"timed out after {timeout} s waiting for {what}")
-            time.sleep(0.005)
+        return wait_for(predicate, timeout, what, 0.005)
 
     def command(self, linear, angular, seconds):
         """Publish (linear, angular) at 20 Hz for ``seconds`` of sim time (a window to collect samples in)."""

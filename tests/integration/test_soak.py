@@ -22,6 +22,8 @@ from rosgraph_msgs.msg import Clock, Log
 from simtest import SIM, alive, figure, finite_odom, node_pid, rss_kib
 from std_srvs.srv import Empty
 
+from diffbot_sim import waiting
+
 SIM_SECONDS = 3600.0
 WARM_UP = 60.0  # sim s before the memory baseline
 RESET_EVERY = 600.0  # sim s
@@ -80,11 +82,8 @@ class SoakTest(unittest.TestCase):
                 return odom.last / 1e9 if odom.last is not None else 0.0
 
         def wait(predicate, timeout, what):
-            deadline = time.monotonic() + timeout
-            while not predicate():
-                self.assertTrue(alive(pid), f"bullet_sim died while waiting for {what}")
-                self.assertLess(time.monotonic(), deadline, f"timed out after {timeout} s waiting for {what}")
-                time.sleep(0.05)
+            return waiting.wait_for(predicate, timeout, what, 0.05, error=self.failureException,
+                                    give_up=lambda: not alive(pid) and "bullet_sim died")
 
         wait(lambda: cmd.get_num_connections() > 0 and odom.count > 0, 30.0, "the simulator")
         started = time.monotonic()

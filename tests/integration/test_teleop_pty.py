@@ -26,6 +26,8 @@ import rospy
 import rostest
 from geometry_msgs.msg import Twist
 
+from diffbot_sim import waiting
+
 PKG = "diffbot_sim"
 READY_TEXT = b"we are ready"
 START_TIMEOUT = 40.0   # s: rosrun + rospy import + registration, on a busy 2-core machine
@@ -128,11 +130,10 @@ class TestTeleopPty(unittest.TestCase):
     # -- helpers ---------------------------------------------------------------------------------------------
 
     def wait_for(self, predicate, timeout, what):
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            if time.monotonic() > deadline:
-                self.fail(f"timed out after {timeout} s waiting for {what}" + self._output_tail())
-            time.sleep(0.002)
+        """``waiting.wait_for`` polling every 2 ms (key-to-Twist times are measured in ms); a failure carries the
+        teleop's output."""
+        return waiting.wait_for(predicate, timeout, what, 0.002,
+                                error=lambda message: self.failureException(message + self._output_tail()))
 
     def _output_tail(self):
         if self.reader is None:

@@ -33,6 +33,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import viewtest  # noqa: E402
 
 from diffbot_sim.view import xscreen  # noqa: E402
+from diffbot_sim.waiting import wait_for  # noqa: E402
 
 ROOM = os.path.join(viewtest.ROOT, "worlds", "room.world")
 ROBOT = "diffbot"  # the seed robot's URDF name: its model name
@@ -90,7 +91,7 @@ class ViewGui(viewtest.PictureSuite):
         """After something went missing (the window, a service): fail naming roslaunch's exit when it ends
         within 5 s (a required node died: roslaunch stops the rest), else return."""
         try:
-            xscreen.wait_for(lambda: self.view.proc.poll() is not None, 5.0, "roslaunch to end", 0.2)
+            wait_for(lambda: self.view.proc.poll() is not None, 5.0, "roslaunch to end", 0.2, error=AssertionError)
         except AssertionError:
             return
         self.view.alive()
@@ -126,7 +127,7 @@ class ViewGui(viewtest.PictureSuite):
             return value
         started = time.monotonic()
         try:
-            value = xscreen.wait_for(check, timeout, what, SETTLE_PERIOD)
+            value = wait_for(check, timeout, what, SETTLE_PERIOD, error=AssertionError)
         except AssertionError as err:
             self.crashed()
             raise AssertionError(f"{what}: {why[0]} ({err})") from None

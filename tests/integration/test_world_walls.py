@@ -10,13 +10,13 @@ goes on.
 """
 import sys
 import threading
-import time
 import unittest
 
 import rospy
 import rostest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
+from simtest import wait_for
 
 SIM = "/bullet_sim"
 SPEED, SECONDS, TOLERANCE = 0.3, 7.0, 0.02
@@ -43,11 +43,7 @@ class WorldWallsTest(unittest.TestCase):
             cls.stamp = msg.header.stamp.to_sec()
 
     def wait(self, predicate, timeout, what):
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            if time.monotonic() > deadline or rospy.is_shutdown():
-                self.fail(f"timed out after {timeout} s waiting for {what}")
-            time.sleep(0.01)
+        return wait_for(predicate, timeout, what, 0.01)
 
     def test_robots_stop_where_the_geometry_says(self):
         every = [lane["robot"] for lane in self.lanes]

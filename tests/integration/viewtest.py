@@ -2,7 +2,7 @@
 ``sim.launch``) started against the rostest master as a user would start it, screenshots, and rviz's own
 services.
 
-Callbacks only record; the test thread asserts. Waits poll with deadlines (xscreen.wait_for).
+Callbacks only record; the test thread asserts. Waits poll with deadlines (diffbot_sim.waiting.wait_for).
 """
 import os
 import re
@@ -22,6 +22,7 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
 
 from diffbot_sim.view import xscreen
+from diffbot_sim.waiting import wait_for
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
 ROBOT = os.path.join(ROOT, "tests", "data", "robots", "view_robot.urdf")
@@ -179,7 +180,7 @@ class View:
         def check():
             self.alive()
             return predicate()
-        return xscreen.wait_for(check, timeout, what)
+        return wait_for(check, timeout, what, 0.1, error=AssertionError)
 
     # ---------------------------------------------------------------------------------------- ROS side
 
@@ -240,7 +241,7 @@ class View:
             self.cmd.publish(twist)
             return done()
         try:
-            xscreen.wait_for(lambda: self.alive() or moved(), timeout, what, period=0.05)
+            wait_for(lambda: self.alive() or moved(), timeout, what, 0.05, error=AssertionError)
         finally:
             self.cmd.publish(Twist())
 

@@ -15,6 +15,8 @@ import threading
 import time
 import xmlrpc.client
 
+from diffbot_sim import waiting
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SETUP = os.path.join(ROOT, "catkin_ws", "devel", "setup.bash")
 MODEL = os.path.join(ROOT, "urdf", "diffbot.urdf.xacro")
@@ -36,19 +38,16 @@ def free_port():
 
 
 def wait_for(predicate, timeout, what, procs=()):
-    """Poll ``predicate`` until truthy; fail after ``timeout`` s or as soon as one of ``procs`` has exited."""
-    deadline = time.monotonic() + timeout
-    while True:
+    """``waiting.wait_for`` (AssertionError, polling every 50 ms) that also fails as soon as one of ``procs``
+    has exited, with its output."""
+    def check():
         value = predicate()
-        if value:
-            return value
-        for proc in procs:
+        for proc in () if value else procs:
             if proc.poll() is not None:
                 raise AssertionError(f"{proc.args_text} exited ({proc.returncode}) while waiting for {what}:\n"
                                      f"{proc.output()}")
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-        time.sleep(0.05)
+        return value
+    return waiting.wait_for(check, timeout, what, 0.05, error=AssertionError)
 
 
 class Proc:

@@ -32,6 +32,8 @@ import time
 import pytest
 from proctools import ROOT, alive, free_port, tree
 
+from diffbot_sim import waiting
+
 PREFIX = os.path.join(tempfile.gettempdir(),
                       f"diffbot_sim-install-test-{os.getuid()}-{hashlib.sha1(ROOT.encode()).hexdigest()[:8]}")
 INSTALL_TIMEOUT = 600.0  # s: a first install configures and builds catkin_ws/build_install (~2 min on 2 cores)
@@ -173,13 +175,17 @@ class Started:
 
 
 def wait_until(predicate, timeout, what, started):
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        output = started.read()[-3000:]
-        assert started.popen.poll() is None, f"exited ({started.popen.returncode}) before {what}:\n{output}"
-        assert time.monotonic() < deadline, f"timed out after {timeout} s waiting for {what}:\n{output}"
+    """``waiting.wait_for`` (polling every 0.1 s) on a process ``started``: fails at once when it has exited,
+    notes the processes it started meanwhile (``started.seen``), and ends a failure with its output's tail."""
+    def check():
+        if predicate():
+            return True
+        assert started.popen.poll() is None, \
+            f"exited ({started.popen.returncode}) before {what}:\n{started.read()[-3000:]}"
         started.seen.update(tree(started.popen.pid))
-        time.sleep(0.1)
+        return False
+    waiting.wait_for(check, timeout, what, 0.1,
+                     error=lambda message: AssertionError(f"{message}:\n{started.read()[-3000:]}"))
 
 
 def tilt(pose):

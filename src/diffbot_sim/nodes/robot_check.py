@@ -36,6 +36,7 @@ from diffbot_sim.check.session import SIM, Session, SessionError
 from diffbot_sim.description.model_files import package_path
 from diffbot_sim.errors import DiffbotSimError, ModelError
 from diffbot_sim.nodes._entry import entry_point
+from diffbot_sim.waiting import wait_for
 
 USAGE = ("usage: rosrun diffbot_sim robot_check <model.urdf|model.urdf.xacro> [controller.yaml ...] "
          "[-- xacro args name:=value ...]")
@@ -193,15 +194,14 @@ class _Latest:
 
 
 def _wait(predicate, timeout, what, session):
-    deadline = time.monotonic() + timeout
-    while not predicate():
+    """``waiting.wait_for`` that fails at once, with bullet_sim's own last word, when bullet_sim has exited."""
+    def check():
         failure = session.sim_failure()
         if failure:
             raise SessionError(failure)
-        if time.monotonic() > deadline:
-            raise SessionError(f"timed out after {timeout:g} s waiting for {what} (bullet_sim log: "
-                               f"{session.sim.log_path}, removed at exit)")
-        time.sleep(0.01)
+        return predicate()
+    return wait_for(check, timeout, what, error=lambda message: SessionError(
+        f"{message} (bullet_sim log: {session.sim.log_path}, removed at exit)"))
 
 
 def _check(session, report):

@@ -27,11 +27,11 @@ Parameters:
 
 Exit status 1, with one line, on a world file that cannot be read or a simulator that never reports.
 """
-import time
 
 from diffbot_sim.errors import DiffbotSimError
 from diffbot_sim.nodes._entry import entry_point
 from diffbot_sim.transforms import quaternion_from_yaw
+from diffbot_sim.waiting import wait_for
 from diffbot_sim.world.loading import robot_namespaces, simulator_world
 
 
@@ -45,17 +45,11 @@ def odom_offset(source, x, y, yaw):
 
 
 def _wait(predicate, timeout, what):
+    """``waiting.wait_for`` as this node fails: one line naming itself, ended early by a ROS shutdown."""
     import rospy
 
-    deadline = time.monotonic() + timeout
-    while not rospy.is_shutdown():
-        value = predicate()
-        if value is not None:
-            return value
-        if time.monotonic() > deadline:
-            raise DiffbotSimError(f"world_markers: no {what} after {timeout:g} s (is bullet_sim running?)")
-        time.sleep(0.1)
-    raise DiffbotSimError("world_markers: shut down while waiting for " + what)
+    return wait_for(predicate, timeout, what, 0.1, give_up=lambda: rospy.is_shutdown() and "shut down",
+                    error=lambda message: DiffbotSimError(f"world_markers: {message} (is bullet_sim running?)"))
 
 
 def _odom_frames(sim, timeout):

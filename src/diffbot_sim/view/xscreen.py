@@ -17,6 +17,8 @@ from typing import List
 
 import numpy as np
 
+from diffbot_sim.waiting import wait_for
+
 SCREEN = (1280, 800)
 #: rviz's text colours in the Displays panel (rviz/properties/status_property.cpp, display.cpp): a display
 #: whose status is Ok is written in blue, Warn in orange, Error in red.
@@ -65,7 +67,8 @@ class Xvfb:
                 else:
                     time.sleep(0.02)
         self.display = ":" + number.decode().strip()
-        wait_for(lambda: _xdpyinfo_ok(self.display), self.timeout, f"Xvfb {self.display} to answer")
+        wait_for(lambda: _xdpyinfo_ok(self.display), self.timeout, f"Xvfb {self.display} to answer", 0.1,
+                 error=AssertionError)
         return self
 
     def stop(self):
@@ -94,19 +97,6 @@ def _xdpyinfo_ok(display):
                               stderr=subprocess.DEVNULL, timeout=5).returncode == 0
     except (OSError, subprocess.TimeoutExpired):
         return False
-
-
-def wait_for(predicate, timeout, what, period=0.1):
-    """Poll ``predicate`` until it returns something true; AssertionError naming ``what`` after
-    ``timeout`` wall seconds."""
-    deadline = time.monotonic() + timeout
-    while True:
-        value = predicate()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout:g} s waiting for {what}")
-        time.sleep(period)
 
 
 @dataclass
@@ -370,4 +360,4 @@ __all__: List[str] = ["Xvfb", "XvfbUnavailable", "Window", "parse_tree", "subtre
                       "screenshot", "save_png", "crop", "count_color", "status_colors", "rows_of_color",
                       "changed", "blob", "patch", "greenish", "top_view_pixel", "project", "orbit_camera",
            "pybullet_pixel", "PYBULLET_CAMERA", "PYBULLET_WINDOW", "saturated", "color_counts", "hue", "HUES",
-           "PYBULLET_SCENE_BOX", "wait_for"]
+           "PYBULLET_SCENE_BOX"]
