@@ -12,16 +12,20 @@ them between updates, so a slower update changes nothing but the CPU spent.
 """
 import rospy
 
+from diffbot_sim.control import ackermann_steering_controller as asc
 from diffbot_sim.control import controller_lookup
 from diffbot_sim.control import controller_switching as switching
 from diffbot_sim.control import diff_drive_config as ddc_cfg
 from diffbot_sim.control import forward_command as fwd
+from diffbot_sim.control import four_wheel_steering_controller as fws
 from diffbot_sim.control import gripper_action_controller as gac
 from diffbot_sim.control import joint_trajectory_controller as jtc
 from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.plugins.base import get_param, join
+from diffbot_sim.plugins.ros_control.ackermann_steering import AckermannSteeringController
 from diffbot_sim.plugins.ros_control.diff_drive import DiffDriveController
 from diffbot_sim.plugins.ros_control.forward_command import ForwardCommandController
+from diffbot_sim.plugins.ros_control.four_wheel_steering import FourWheelSteeringController
 from diffbot_sim.plugins.ros_control.gripper_action import GripperActionController
 from diffbot_sim.plugins.ros_control.joint_state import JointStateController
 from diffbot_sim.plugins.ros_control.joint_trajectory import JointTrajectoryController
@@ -34,7 +38,10 @@ JSC_TYPE = JointStateController.type
 def _factories():
     """controller type -> ``factory(ctx, hw, full_name, params, manager_ns)``."""
     table = {ddc_cfg.CONTROLLER_TYPE: lambda ctx, hw, name, params, ns: DiffDriveController(ctx, hw, name, params),
-             JSC_TYPE: JointStateController}
+             JSC_TYPE: JointStateController,
+             asc.CONTROLLER_TYPE: lambda ctx, hw, name, params, ns: AckermannSteeringController(ctx, hw, name, params),
+             fws.CONTROLLER_TYPE: lambda ctx, hw, name, params, ns: FourWheelSteeringController(ctx, hw, name,
+                                                                                               params)}
     for kind in fwd.CONTROLLER_TYPES:
         table[kind] = lambda ctx, hw, name, params, ns: ForwardCommandController(ctx, hw, name, params)
     for kind in jtc.CONTROLLER_TYPES:
