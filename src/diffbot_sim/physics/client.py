@@ -23,7 +23,7 @@ def quiet(fd):
 
 try:
     with quiet(1), quiet(2):
-        import pybullet  # noqa: F401 (the package's one import of it; world.py and robot.py take it from here)
+        import pybullet  # noqa: F401 (the package's one import of it; the other physics modules take it from here)
         import pybullet_data  # noqa: F401
 except ImportError as _missing:
     # One line and status 1, not a traceback: the usual cause is a node started by a Python other than the

@@ -19,7 +19,7 @@ def contact_damping(kp, kd, time_step, max_erp):
     kept whatever the damping, while the ERP, how much of a penetration is undone per step, grows to ~1 for
     the stiff, lightly damped contacts real models give (kp 1e7, kd 1). Gazebo caps that correction at
     ``<max_vel>``; Bullet cannot, so the damping is raised until the ERP is at most ``max_erp``: the same
-    spring, damped enough not to throw what lands on it (see LANDING_CORRECTION_RATE).
+    spring, damped enough not to throw what lands on it (see landing.LANDING_CORRECTION_RATE).
     """
     stiff = time_step * kp
     return max(kd, 0.0, stiff * (1.0 / max_erp - 1.0)) if max_erp < 1.0 else max(kd, 0.0)

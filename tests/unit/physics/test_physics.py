@@ -65,7 +65,7 @@ def test_loaded_mass_equals_urdf_mass(seed, seed_model):
 
 
 def test_without_lumping_pybullet_adds_a_phantom_kilogram(make_world, seed_urdf, seed_model, monkeypatch):
-    monkeypatch.setattr(physics.world.lumping, "lump", lambda text, root, surface: lumping.LumpedUrdf(text, {}))
+    monkeypatch.setattr(lumping, "lump", lambda text, root, surface: lumping.LumpedUrdf(text, {}))
     robot = make_world().load_robot(seed_urdf, seed_model)
     assert robot.total_mass() == pytest.approx(seed_model.total_mass() + 1.0, abs=1e-5)
 

@@ -190,7 +190,7 @@ def test_no_journal_without_a_ray_process_to_come(seed_urdf):
     w = World(DT)
     try:
         w.load_robot(seed_urdf, parse_urdf(seed_urdf, "seed"))
-        assert w._journal is None and w.ray_helper is None
+        assert w.ray_link.journal is None and w.ray_helper is None
     finally:
         w.close()
 
@@ -202,7 +202,7 @@ def test_a_body_removed_before_the_ray_process_starts_leaves_its_journal(seed_ur
         for _ in range(5):
             w.remove_robot(w.load_robot(seed_urdf, model, (1.0, 0.0, 0.0)))
             w.remove_body(w.add_kinematic_box((0.2, 0.2, 0.2), ((0.0, 1.0, 0.1), (0, 0, 0, 1))))
-        assert [kind for kind, _ in w._journal] == ["plane"]
+        assert [kind for kind, _ in w.ray_link.journal] == ["plane"]
         kept = w.load_robot(seed_urdf, model, (1.0, 0.0, 0.0))
         w.step()
         w.start_ray_process()
