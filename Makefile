@@ -18,8 +18,9 @@ test-slow: setup
 	@bash $(ENV) python3 $(ROOT)/tools/run_tests.py --slow
 
 # Speed, latency, start-up and scale figures (tools/bench.py; ~6 min; writes bench-results/bench.json).
+# ITEMS=fleet,arm runs only those items (`bash tools/rosenv.sh python3 tools/bench.py --help` lists them).
 bench: setup
-	@bash $(ENV) python3 $(ROOT)/tools/bench.py
+	@bash $(ENV) python3 $(ROOT)/tools/bench.py $(if $(ITEMS),--only $(ITEMS))
 
 # The README's pictures (docs/rviz.png, docs/run.png, docs/pybullet.png) from a scripted run under Xvfb, and
 # the rviz first-frame figure (tools/pictures.py; about 1 min).

@@ -29,18 +29,16 @@ import math
 import multiprocessing
 import os
 import subprocess
-import sys
 import time
 from multiprocessing import shared_memory
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import bench  # noqa: E402  (tools/ on the path first)
-import bench_wave  # noqa: E402
+from bench_items import fleet
+from benchkit import bare
+from benchkit.common import STEP  # s: the fleet's step, as make bench
+from benchkit.launching import free_port
 
-sys.path.insert(0, os.path.join(bench.ROOT, "src"))
-STEP = bench.STEP          # s: the fleet's step, as make bench
 ODOM_EVERY = 8             # steps: odometry at 30 Hz
 SCAN_GROUPS = 6            # scan ticks per scan period: each robot scans at 5 Hz
 BEAMS, RANGE_MIN, RANGE_MAX = 360, 0.12, 3.5  # tb3like's <ray>, for the messages (the casting reads the model)
@@ -48,13 +46,13 @@ BEAMS, RANGE_MIN, RANGE_MAX = 360, 0.12, 3.5  # tb3like's <ray>, for the message
 
 def load_fleet(count):
     """``(World, robots, (laser link, RayConfig), parsed model)``: ``count`` tb3like robots with their lasers on
-    make bench's 1 m grid, the laser as ``bench_wave.fleet_laser`` reads it."""
+    make bench's 1 m grid, the laser as ``bench_items.fleet.fleet_laser`` reads it."""
     from diffbot_sim.physics import World
-    model = bench_wave.fleet_model(True)
-    text, parsed = bench_wave.loadable(model)
+    model = fleet.fleet_model(True)
+    text, parsed = bare.load(model)
     world = World(STEP)
     robots = [world.load_robot(text, parsed, (float(i % 10), float(i // 10), 0.0)) for i in range(count)]
-    return world, robots, bench_wave.fleet_laser(model), parsed
+    return world, robots, fleet.fleet_laser(model), parsed
 
 
 class Shared:
@@ -75,7 +73,7 @@ class Shared:
 class Scanner:
     """Casts the due robots' scans in ``world`` into the shared ranges, from where its robots are now: the
     model's rays from the laser's link (``Robot.link_pose``: PyBullet's base pose is the inertial frame, not
-    the link's), as the simulator and ``bench_wave.bare_fleet`` cast them."""
+    the link's), as the simulator and ``bench_items.fleet.bare_fleet`` cast them."""
 
     def __init__(self, world, robots, laser, parsed, shared, threads):
         from diffbot_sim.sensors import ray as ray_sensor
@@ -281,7 +279,7 @@ def main():
     parser.add_argument("--ray-threads", type=int, default=0,
                         help="rayTestBatch's numThreads (0: Bullet's pool, as the simulator casts; 1: one thread)")
     options = parser.parse_args()
-    port = bench.free_port()
+    port = free_port()
     os.environ["ROS_MASTER_URI"] = f"http://localhost:{port}"
     master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)], stdout=subprocess.DEVNULL,
                               stderr=subprocess.DEVNULL, start_new_session=True)

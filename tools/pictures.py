@@ -238,12 +238,12 @@ def fleet_picture(path, side=10, spacing=1.0):
     import numpy as np
     import pybullet
 
-    sys.path.insert(0, os.path.join(ROOT, "tools"))
-    import bench_wave  # noqa: E402  (tools/: the fleet item's model)
+    from bench_items import fleet  # tools/bench_items: the fleet item's model
+    from benchkit import bare
 
     from diffbot_sim.physics import World
 
-    text, parsed = bench_wave.loadable(bench_wave.fleet_model(True))
+    text, parsed = bare.load(fleet.fleet_model(True))
     world = World(1.0 / 240.0)
     width = height = 1400
     try:

@@ -533,8 +533,8 @@ def test_two_megabyte_stl_cold_and_cached(tmp_path):
 
     Measured here (2 cores): about 0.09 s cold and 0.3 ms cached. The bounds are 20x and over 100x that,
     so a busy machine never misses them; they catch a conversion gone quadratic or a cache not used. The
-    start-up figures (first /odom with this much STL, cache empty and filled) are tools/bench.py's
-    ``meshes`` benchmark."""
+    start-up figures (first /odom with this much STL, cache empty and filled) are make bench's
+    ``meshes`` item (tools/bench_items/startup.py)."""
     rng = np.random.default_rng(1)
     points = rng.random((20000, 3)) * 1000.0
     triangles = points[rng.integers(0, len(points), (40000, 3))]

@@ -404,8 +404,8 @@ def _timed_synthetic(tmp_path, size):
 def test_2000_cell_map_loads_fast(tmp_path):
     """The walls are merged boxes, not a box per cell: few triangles, and read in about 0.07 s here (2 cores).
     The time bound is 40x that, so a busy machine never misses it; it catches only a per-cell regression.
-    The start-up figure that matters (first /odom in a 4000 x 4000 map, <= 3 s) is tools/bench.py's
-    ``worlds`` benchmark."""
+    The start-up figure that matters (first /odom in a 4000 x 4000 map, <= 3 s) is make bench's
+    ``worlds`` item (tools/bench_items/startup.py)."""
     elapsed, triangles = _timed_synthetic(tmp_path, 2000)
     assert elapsed < 3.0, f"read_map took {elapsed:.2f} s"
     assert triangles < 2_000_000
@@ -413,7 +413,7 @@ def test_2000_cell_map_loads_fast(tmp_path):
 
 @pytest.mark.slow
 def test_4000_cell_map_stays_small(tmp_path):
-    """A 4000 x 4000 map (read in about 0.45 s here): bounded geometry; its load time is tools/bench.py's
+    """A 4000 x 4000 map (read in about 0.45 s here): bounded geometry; its load time is make bench's
     ``worlds`` figure (first /odom, <= 3 s), not a unit-test assertion."""
     _, triangles = _timed_synthetic(tmp_path, 4000)
     assert triangles < 4_000_000
