@@ -2,7 +2,6 @@
 what is due and publishes /clock and /tf (rospy). Subscriber and service callbacks only hand data to it
 (``call``/``post``); it knows no plugin by name."""
 import math
-import socket
 import sys
 import threading
 import time
@@ -16,6 +15,7 @@ from diffbot_sim.config import wants_ray_process
 from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.physics import World
 from diffbot_sim.plugins.base import next_due, publisher
+from diffbot_sim.simulator.subscriber_links import SubscriberLinks
 from diffbot_sim.simulator.sync import NodeSync
 from diffbot_sim.simulator.throttle import Throttle
 
@@ -27,83 +27,8 @@ CALL_TIMEOUT = 60.0
 #: (Python's default is 5 ms). PyBullet's calls keep the lock, so in fast mode the loop holds it all the time
 #: but for these hand-overs; a service call or a new connection crosses a dozen of them (accept, header,
 #: request, hand-over to the loop, reply), each a full interval late: at 5 ms, reset_simulation took
-#: 46-154 ms. See performance.md for the figures at this value.
+#: 46-154 ms. See docs/performance.md for the figures at this value.
 GIL_SWITCH_INTERVAL = 0.0005
-
-
-class SubscriberLinks:
-    """Our publishers' TCP connections to subscribers: tuned once each, and batched in fast mode.
-
-    Publishers are synchronous (the loop's thread writes; no queue thread per connection, which costs
-    more CPU than the write itself), so a subscriber that stops reading must not stall the loop: each
-    connection gets a send timeout, after which rospy closes and drops it (the loop goes on, the
-    subscriber sees the connection end). TCP_NODELAY stops Nagle holding a small message for an ACK.
-
-    In fast mode, a message to a subscriber that is asleep costs ~100-150 us of wall time (the loopback
-    write wakes the receiver, a cross-CPU wake-up that is dear in a VM), far more than building it; so the
-    connections are corked (TCP_CORK) while the loop publishes and uncorked every ``batch`` wall seconds:
-    N writes become one wake-up per subscriber; messages and their order are unchanged, each arrives at
-    most ``batch`` late. Real-time mode does not batch.
-    """
-
-    def __init__(self, publishers, send_timeout, batch):
-        self.publishers = publishers  # callable returning the current publishers
-        self.send_timeout = send_timeout
-        self.batch = batch
-        self.held_since = None
-        self._tuned = set()  # the live sockets, as of the last scan (every 0.1 s at most)
-        self._corked = []  # the sockets corked by the open batch
-        self._next_scan = 0.0
-
-    def _sockets(self):
-        for pub in self.publishers():
-            for conn in list(pub.impl.connections) if pub.impl is not None else ():
-                sock = getattr(conn, "socket", None)
-                if sock is not None and sock.family in (socket.AF_INET, socket.AF_INET6):
-                    yield sock
-
-    def tune_new(self, now_wall):
-        """Give new connections their send timeout and TCP_NODELAY (a scan at most every 0.1 s)."""
-        if now_wall < self._next_scan:
-            return
-        self._next_scan = now_wall + 0.1
-        live = set()  # the socket objects themselves: an id() could be reused by a later socket
-        for sock in self._sockets():
-            live.add(sock)
-            if sock not in self._tuned:
-                try:
-                    sock.settimeout(self.send_timeout)
-                    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-                except OSError:
-                    pass  # closing under us: rospy drops it on its next write
-        self._tuned = live
-
-    @staticmethod
-    def _cork(sockets, value):
-        for sock in sockets:
-            try:
-                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_CORK, value)
-            except OSError:
-                pass
-
-    def hold(self, now_wall):
-        """Fast mode, before publishing: start a batch unless one is open (on the sockets of the last scan: a
-        connection newer than that is written at once, as in real time)."""
-        if self.batch > 0 and self.held_since is None:
-            self._corked = list(self._tuned)
-            self._cork(self._corked, 1)
-            self.held_since = now_wall
-
-    def release_if_due(self, now_wall):
-        if self.held_since is not None and now_wall - self.held_since >= self.batch:
-            self.release()
-
-    def release(self):
-        """Send everything held now (also before the loop pauses, and at close)."""
-        if self.held_since is not None:
-            self._cork(self._corked, 0)
-            self._corked = []
-            self.held_since = None
 
 
 class RobotRuntime:
@@ -183,7 +108,7 @@ class Simulator:
         self.owns_clock = False  # main() sets it when use_sim_time made rospy follow /clock
         self.world_description = None  # the world file's, when ~world names one
         self.links = SubscriberLinks(self.publishers, cfg.send_timeout, 0.0 if cfg.real_time else cfg.fast_batch)
-        self.api = None  # the /gazebo world API (nodes.gazebo_api), when ~enable_ros_network
+        self.api = None  # the /gazebo services (simulator.gazebo_services.GazeboApi), when ~enable_ros_network
         self.paused = cfg.paused
         self.actors = None  # the world's <actor>s (simulator.actors.Actors), when it has any
         self.sync = NodeSync(cfg.wait_for_nodes_timeout, cfg.wait_for_nodes_ignore, rospy.get_name(), self.warn)
@@ -497,7 +422,7 @@ class Simulator:
         """/clock at the current sim time, unless ``wall`` is given and too soon (see _publish_clock)."""
         stamp = self.stamp()
         if self.owns_clock:
-            rospy.rostime._set_rostime(stamp)  # this node's own sim time (see _own_the_clock)
+            rospy.rostime._set_rostime(stamp)  # this node's own sim time (see nodes/sim_node.py's _own_the_clock)
         if wall is not None and wall - self._clock_wall < self.clock_min_gap:
             self._clock_coalesced = True
             return False

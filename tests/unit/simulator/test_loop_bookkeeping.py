@@ -1,9 +1,11 @@
-"""simulator.loop's bookkeeping without a master: SubscriberLinks (each connection tuned once, corked batches in
-fast mode) and RobotRuntime (what the loop asks a robot, answered from its plugins)."""
+"""The loop's bookkeeping without a master: simulator.subscriber_links's SubscriberLinks (each connection tuned
+once, corked batches in fast mode) and simulator.loop's RobotRuntime (what the loop asks a robot, answered from
+its plugins)."""
 import math
 import socket
 
-from diffbot_sim.simulator.loop import RobotRuntime, SubscriberLinks
+from diffbot_sim.simulator.loop import RobotRuntime
+from diffbot_sim.simulator.subscriber_links import SubscriberLinks
 
 
 class Sock:
