@@ -53,7 +53,7 @@ def env_round(env, steps, actions):
 def bare_round(scene, sim_seconds):
     """(wall s, CPU s) of stepping the scene's world bare for ``sim_seconds`` of sim time."""
     scene.reset(0.0, 0.0, 0.0)
-    scene.drive.command(0.1, 0.5, 0.0)
+    scene.drive.command(0.1, 0.5)
     scene.drive.before_step(0.0)  # the wheel motors set once; from here on only the physics runs
     world = scene.world
     count = int(round(sim_seconds / scene.cfg.time_step))

@@ -18,10 +18,9 @@ from diffbot_sim.check import arm_report
 from diffbot_sim.check.drive_check import HOLONOMIC_PLUGINS
 from diffbot_sim.control import diff_drive_config as ddc
 from diffbot_sim.control.controller_lookup import find_controllers
-from diffbot_sim.description import meshes
-from diffbot_sim.description.model_files import load_file, parse_args
-from diffbot_sim.description.plugin_tags import DIFF_DRIVE, JOINT_STATE, read_plugins
-from diffbot_sim.description.urdf_model import parse_urdf, tag_value
+from diffbot_sim.description.plugin_tags import DIFF_DRIVE, JOINT_STATE
+from diffbot_sim.description.prepared_model import prepare_model, read_model_file
+from diffbot_sim.description.urdf_model import tag_value
 
 SKID_STEER = "libgazebo_ros_skid_steer_drive.so"
 PLANAR_MOVE = "libgazebo_ros_planar_move.so"
@@ -157,15 +156,10 @@ def build_report(path, model_args="", controller_files=(), known=(), known_senso
     Raises:
         ModelError, ConfigError: what would stop bullet_sim, naming the file, element or parameter.
     """
-    source = os.path.abspath(os.path.expanduser(path))
-    text = load_file(source, parse_args(model_args))
-    model = parse_urdf(text, source)
-    text, mesh_notes = meshes.prepare_meshes(text, source, os.path.dirname(source),
-                                             cache_dir or meshes.default_cache_dir(),
-                                             resolve_package or _no_package)
-    found = read_plugins(model, known=known, known_sensors=known_sensors)
-    for trans in model.transmissions:
-        model.joint(trans.joint, f"/robot/transmission[@name='{trans.name}']")
+    text, source = read_model_file(path, model_args)
+    prepared = prepare_model(text, source, known=known, known_sensors=known_sensors, cache_dir=cache_dir,
+                             resolve_package=resolve_package or _no_package)
+    text, model, found, mesh_notes = prepared.text, prepared.model, prepared.plugins, prepared.notes
     tree = {}
     origin = {}  # controller namespace -> the file that last set it
     for name, values in controller_files:

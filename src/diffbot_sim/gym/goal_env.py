@@ -78,6 +78,7 @@ class GoalConfig:
     actions: str = "discrete"  # discrete (TurtleBot3's 5) or continuous
     control_period: float = 0.2  # s of sim time per step: a multiple of time_step
     time_step: float = 1.0 / 240.0  # s, bullet_sim's default
+    cmd_vel_timeout: float = 0.0  # s, bullet_sim's ~cmd_vel_timeout: > 0 brakes a command older than it; 0: held
     max_linear: float = 0.3  # m/s, continuous actions
     max_angular: float = 1.5  # rad/s, continuous actions
     goal_radius: float = 0.2  # m
@@ -123,7 +124,7 @@ def goal_config(**kwargs):
         raise ConfigError(name("control_period"), cfg.control_period, f"a multiple of time_step {cfg.time_step:g}")
     for key in ("map_wall_height", "max_linear", "max_angular", "goal_radius", "grid"):
         setattr(cfg, key, check_number(name(key), getattr(cfg, key), low=0.0, low_open=True))
-    for key in ("min_goal_distance", "clearance", "collision_range"):
+    for key in ("min_goal_distance", "clearance", "collision_range", "cmd_vel_timeout"):
         setattr(cfg, key, check_number(name(key), getattr(cfg, key), low=0.0))
     for key in ("progress_reward", "goal_reward", "collision_reward", "step_reward"):
         setattr(cfg, key, check_number(name(key), getattr(cfg, key)))

@@ -1,17 +1,18 @@
 """One robot in one world, in-process and without ROS, for learning environments: loaded as bullet_sim loads
 them, driven by gazebo_ros_diff_drive's controller, seen through its own laser, reset by restoring a snapshot.
 
-What bullet_sim does and this repeats (so a policy sees what it would see through ROS):
+What bullet_sim does, this does through the same code (so a policy sees what it would see through ROS):
 
 * The world through ``world.loading.load_world`` (SDF ``.world`` or map_server ``.yaml``), its gravity, and
-  ``physics.World.load_world``; the robot's model file through ``description.model_files`` (xacro in-process),
-  parsed, meshes prepared and placed as ``simulator/robots.py`` ``_build_robot`` does (raised onto the world at
-  its spawn point, set down calmly by ``World.load_robot``).
+  ``physics.World.load_world``; the robot's model read by ``description.prepared_model`` (xacro in-process,
+  parsed, meshes prepared) and placed by ``physics.robot_loading.place_robot`` (raised onto the world at its
+  spawn point, set down calmly by ``World.load_robot``), as ``simulator/robots.py`` does.
 * The drive: the model's ``libgazebo_ros_diff_drive.so`` tags (or ``left_joints``... given as parameters, as
-  bullet_sim's ``~left_joints``) read by ``config.drive_config``; each physics step runs what
-  ``plugins/diff_drive.py`` runs before a step: a new command is applied at once, otherwise the controller
-  (``control.gazebo_diff_drive``) updates at the plugin's ``<update_rate>`` from the measured wheel speeds,
-  with its acceleration and wheel-speed limits, and sets the wheel velocity motors.
+  bullet_sim's ``~left_joints``) read by ``config.drive_config``; before each physics step the plugin's own
+  step runs (``control.gazebo_diff_drive``, which ``plugins/diff_drive.py`` wraps with ROS): a new command
+  reaches the wheel motors at once, otherwise the wheels are updated at the plugin's ``<update_rate>`` from
+  their measured speeds, with its acceleration and wheel-speed limits, and braked when a command outlives
+  bullet_sim's ``cmd_vel_timeout`` (0 by default: held, as in Gazebo).
 * The laser: the model's ``<sensor type="ray">`` read by ``sensors.ray.parse_sensor``, mounted as
   ``sensors.ray.mounted_pose`` says, its rays cast by ``World.ray_batch`` and turned into ranges (REP 117
   mask, Gazebo's noise) by ``sensors.ray.ScanProcessor``, as ``plugins/laser.py`` does.
@@ -27,16 +28,14 @@ import os
 import numpy as np
 
 from diffbot_sim import config as cfgmod
-from diffbot_sim.control.gazebo_diff_drive import DiffDriveController
-from diffbot_sim.control.schedule import next_due
+from diffbot_sim.control.gazebo_diff_drive import DiffDriveController, DriveWheels
 from diffbot_sim.description import meshes
-from diffbot_sim.description.model_files import load_file, package_path, parse_args
-from diffbot_sim.description.plugin_tags import read_plugins
-from diffbot_sim.description.urdf_model import parse_urdf
+from diffbot_sim.description.model_files import package_path
+from diffbot_sim.description.prepared_model import prepare_model, read_model_file
 from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.gym.free_space import arena_bounds, grid, reachable_cells
 from diffbot_sim.physics import World
-from diffbot_sim.physics.world import LANDING_MAX_TIME
+from diffbot_sim.physics.robot_loading import place_robot, settle
 from diffbot_sim.sensors import ray as ray_sensor
 from diffbot_sim.transforms import qmul, quaternion_from_yaw, yaw_from_quaternion
 from diffbot_sim.world.loading import load_world
@@ -79,47 +78,40 @@ def resolve_model(name):
 
 
 class Drive:
-    """gazebo_ros_diff_drive's control loop (``plugins/diff_drive.py`` ``before_step``) on the robot's wheels."""
+    """The robot's gazebo_ros_diff_drive: the plugin's own step (``control.gazebo_diff_drive``, as
+    ``plugins/diff_drive.py`` runs it under ROS) on the robot's wheels, commanded by the environment's actions
+    instead of ``cmd_vel``.
 
-    def __init__(self, robot, model, drive, max_wheel_velocity, time_step):
-        self.robot, self.drive, self.time_step = robot, drive, time_step
-        self.controller = DiffDriveController(drive.wheel_separation, drive.wheel_radius, max_wheel_velocity,
-                                              drive.max_wheel_acceleration, 0.0)
-        self.left = robot.indices(drive.left_joints)
-        self.right = robot.indices(drive.right_joints)
-        self.wheels = self.left + self.right
-        self.forces = cfgmod.wheel_efforts(model, drive)
-        self.period = 1.0 / drive.update_rate if drive.update_rate > 0 else 0.0
-        self.max_linear = max_wheel_velocity * drive.wheel_radius
-        self.max_angular = 2.0 * self.max_linear / drive.wheel_separation
-        self.next_update = self.last_update = 0.0
-        self.fresh = False
+    Args:
+        sim: bullet_sim's settings this drive follows as the plugin does (``config.SimConfig``: its
+            ``max_wheel_velocity``, ``cmd_vel_timeout`` and ``time_step``).
+    """
 
-    def command(self, linear, angular, now):
-        """A cmd_vel (linear.x [m/s], angular.z [rad/s]) arriving at sim time ``now``: applied at the next step."""
-        self.fresh = self.controller.set_command(float(linear), float(angular), now)
+    def __init__(self, robot, model, drive, sim):
+        max_wheel_velocity = cfgmod.max_wheel_velocity(sim, model, drive)
+        self.core = DiffDriveController(drive.wheel_separation, drive.wheel_radius, max_wheel_velocity,
+                                        drive.max_wheel_acceleration, sim.cmd_vel_timeout, drive.update_rate,
+                                        sim.time_step)
+        self.wheels = DriveWheels(robot, robot.indices(drive.left_joints), robot.indices(drive.right_joints),
+                                  cfgmod.wheel_efforts(model, drive))
+        self.max_linear, self.max_angular = self.core.max_linear, self.core.max_angular
+
+    def command(self, linear, angular):
+        """A cmd_vel (linear.x [m/s], angular.z [rad/s]): it reaches the wheels at the next step. A non-finite
+        one is dropped (the plugin's subscriber drops it), so the last valid command holds."""
+        linear, angular = float(linear), float(angular)
+        if math.isfinite(linear) and math.isfinite(angular):
+            self.core.inbox.put((linear, angular))
 
     def before_step(self, now):
-        """Update the wheel motors when a command is new or the plugin's update is due."""
-        if not self.fresh and now + 1e-9 < self.next_update:
-            return
-        self.fresh = False
-        _, velocities, _ = self.robot.joint_states(self.wheels)
-        n = len(self.left)
-        dt = max(now - self.last_update, self.time_step)
-        left, right = self.controller.update(now, sum(velocities[:n]) / n, sum(velocities[n:]) / n, dt)
-        self.robot.set_velocities(self.wheels, [left] * n + [right] * n, self.forces)
-        self.last_update = now
-        if now + 1e-9 >= self.next_update:
-            self.next_update = next_due(self.next_update, self.period, now)
+        """The plugin's work before the physics step at sim time ``now``."""
+        self.core.before_step(now, self.wheels)
 
     def reset(self):
-        """The plugin's Reset: command zero, wheel motors braking, the schedule from sim time 0."""
-        self.controller.brake()
-        self.controller.targets = (0.0, 0.0)
-        self.robot.set_velocities(self.wheels, [0.0] * len(self.wheels), self.forces)
-        self.next_update = self.last_update = 0.0
-        self.fresh = False
+        """The plugin's Reset, then its start at sim time 0: command zero, wheel motors braking."""
+        self.core.reset()
+        self.wheels.brake()
+        self.core.start(0.0)
 
 
 class Laser:
@@ -195,20 +187,14 @@ class Scene:
 
     def _build(self):
         cfg, world = self.cfg, self.world
-        path = resolve_model(cfg.model)
-        text = load_file(path, parse_args(cfg.model_args))
-        model = parse_urdf(text, path)
-        text, notes = meshes.prepare_meshes(text, path, os.path.dirname(path), meshes.default_cache_dir(),
-                                            package_path)
-        found = read_plugins(model)
-        for trans in model.transmissions:
-            model.joint(trans.joint, f"/robot/transmission[@name='{trans.name}']")
+        self.prepared = prepare_model(*read_model_file(resolve_model(cfg.model), cfg.model_args))
+        model, found, notes = self.prepared.model, self.prepared.plugins, list(self.prepared.notes)
         drive = cfgmod.drive_config(model, found.diff_drive, dict(cfg.drive), notes)
         if drive is None:
             raise ConfigError("GoalEnv drive", cfg.drive, "a model with a libgazebo_ros_diff_drive.so plugin, or "
                               "left_joints/right_joints naming its wheels")
         sensor = _ray_sensor(found, cfg.sensor)
-        self.model, self.text = model, text
+        self.model = model
         self.warnings = model.warnings + notes + found.warnings
         self.ground = {world.plane} if world.plane is not None else set()
         self.ground |= {uid for uid, body in world.world_bodies if all(s.kind == "plane" for s in body.shapes)}
@@ -223,23 +209,18 @@ class Scene:
             world.remove_robot(robot)
             robot = self._load_robot(float(near[0]), float(near[1]), yaw)
         self.robot = robot
-        max_wheel = cfgmod.max_wheel_velocity(cfgmod.SimConfig(), model, drive)
-        self.drive = Drive(robot, model, drive, max_wheel, cfg.time_step)
+        sim = cfgmod.SimConfig(time_step=cfg.time_step, cmd_vel_timeout=cfg.cmd_vel_timeout)  # bullet_sim's defaults
+        self.drive = Drive(robot, model, drive, sim)
         self.laser = Laser(robot, model, sensor, cfg.beams, cfg.scan_mode, cfg.laser_noise)
         self.warnings += self.laser.warnings
         self.drive.reset()
-        for _ in range(round(LANDING_MAX_TIME / cfg.time_step) + 1):
-            if robot not in world.landing:
-                break
-            world.step()
+        settle(world, robot)
         self.rest_pose = robot.base_pose()
         self.state = world.save_state()
 
     def _load_robot(self, x, y, yaw):
         """The robot placed as bullet_sim places it: raised onto the world at (x, y), turned by ``yaw``."""
-        world = self.world
-        z = max(0.0, world.top_at(x, y, ignore=[r.body for r in world.robots])) if world.world_bodies else 0.0
-        return world.load_robot(self.text, self.model, (x, y, z), yaw)
+        return place_robot(self.world, self.prepared, x, y, 0.0, yaw)
 
     def _free_cells(self, robot, near):
         """The reachable free cells (free_space) for this robot, and its footprint (radius, bottom, top)."""
@@ -279,7 +260,7 @@ class Scene:
         touches a body other than the ground ends the run early. Returns the PyBullet ids it touches (empty:
         none)."""
         world, body, ground, drive = self.world, self.robot.body, self.ground, self.drive
-        drive.command(linear, angular, self.time)
+        drive.command(linear, angular)
         step_time = self.cfg.time_step
         touched = frozenset()
         for index in range(1, steps + 1):

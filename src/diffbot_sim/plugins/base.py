@@ -5,7 +5,6 @@ The loop is single-threaded: subscriber callbacks (rospy's threads) only store d
 """
 import math
 import re
-import threading
 import warnings
 from dataclasses import dataclass
 from typing import Optional
@@ -64,34 +63,22 @@ def finite_twist(ctx, msg, owner):
     return values
 
 
-class PlanarCommandInbox:
-    """The latest finite body-velocity command (vx, vy, wz) [m/s, rad/s] of a planar base plugin, handed from
-    rospy's callback thread to the loop's (which takes it in ``before_step``); a new one wakes the loop."""
+#: Which Twist fields (indices in TWIST_FIELDS order) a drive takes: a wheeled drive linear.x and angular.z, a
+#: planar base linear.x, linear.y and angular.z.
+DRIVE_TWIST = (0, 5)
+PLANAR_TWIST = (0, 1, 5)
 
-    def __init__(self, ctx, owner):
-        self.ctx, self.owner = ctx, owner
-        self._lock = threading.Lock()
-        self._pending = None
 
-    def on_twist(self, msg):
-        values = finite_twist(self.ctx, msg, self.owner)
-        if values is None:
-            return
-        with self._lock:
-            self._pending = (values[0], values[1], values[5])
-        self.ctx.sim.wake.set()
-
-    def take(self):
-        """The command received since the last call, or None."""
-        if self._pending is None:
-            return None
-        with self._lock:
-            command, self._pending = self._pending, None
-        return command
-
-    def clear(self):
-        with self._lock:
-            self._pending = None
+def twist_callback(ctx, owner, inbox, fields):
+    """The rospy callback of a velocity-command topic: each message's Twist ``fields`` (DRIVE_TWIST,
+    PLANAR_TWIST) put into ``inbox`` (a :class:`diffbot_sim.control.command_inbox.CommandInbox` that wakes
+    the loop), which the plugin takes on the loop's thread in ``before_step``. A message with a non-finite
+    field is dropped with a throttled warning (:func:`finite_twist`): the robot keeps its last valid command."""
+    def callback(msg):
+        values = finite_twist(ctx, msg, owner)
+        if values is not None:
+            inbox.put(tuple(values[i] for i in fields))
+    return callback
 
 
 @dataclass

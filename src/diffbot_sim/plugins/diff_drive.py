@@ -1,13 +1,13 @@
 """``libgazebo_ros_diff_drive.so`` (ROS 1 and ROS 2 tags) and, with other tags and defaults,
 ``libgazebo_ros_skid_steer_drive.so`` (see :mod:`diffbot_sim.plugins.skid_steer`).
 
-Tags, defaults and validation: :class:`diffbot_sim.config.DriveConfig` (one place). Kinematics, limits
-and encoder odometry: the shared pure units (controller, kinematics, limits, odometry).
+Tags, defaults and validation: :class:`diffbot_sim.config.DriveConfig` (one place). What it does each step
+(commands, schedule, timeout, limits, wheel speeds): :class:`diffbot_sim.control.gazebo_diff_drive.DiffDriveController`,
+the one engine the Gymnasium scene drives too; this module adds the ROS side and the odometry.
 
 Topics (relative to the plugin's namespace): ``cmd_vel`` in (Twist: linear.x, angular.z), ``odom`` out,
 ``/tf`` odometry frame -> base frame when publish_odom_tf; ``~debug/cmd_applied`` when asked.
 """
-import threading
 import time
 
 import rospy
@@ -15,10 +15,10 @@ from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 
 from diffbot_sim import config as cfgmod
-from diffbot_sim.control.gazebo_diff_drive import DiffDriveController
+from diffbot_sim.control.gazebo_diff_drive import DiffDriveController, DriveWheels
 from diffbot_sim.control.odometry import EncoderOdometry
 from diffbot_sim.messages import common as ros_msgs
-from diffbot_sim.plugins.base import Plugin, finite_twist, join, next_due
+from diffbot_sim.plugins.base import DRIVE_TWIST, Plugin, join, next_due, twist_callback
 from diffbot_sim.transforms import quaternion_from_yaw
 
 
@@ -34,45 +34,25 @@ class DiffDrive(Plugin):
         cfg, robot = ctx.cfg, ctx.robot
         self.max_wheel_velocity = cfgmod.max_wheel_velocity(cfg, ctx.model, drive)
         self.controller = DiffDriveController(drive.wheel_separation, drive.wheel_radius, self.max_wheel_velocity,
-                                              drive.max_wheel_acceleration, cfg.cmd_vel_timeout)
+                                              drive.max_wheel_acceleration, cfg.cmd_vel_timeout, drive.update_rate,
+                                              cfg.time_step, ctx.sim.wake.set)
         self.left_idx = robot.indices(drive.left_joints)
         self.right_idx = robot.indices(drive.right_joints)
-        self.wheel_idx = self.left_idx + self.right_idx
-        self.wheel_forces = cfgmod.wheel_efforts(ctx.model, drive)
-        self.update_period = 1.0 / drive.update_rate if drive.update_rate > 0 else 0.0
-        self.next_update = 0.0
-        self.last_update = 0.0
+        self.wheels = DriveWheels(robot, self.left_idx, self.right_idx, cfgmod.wheel_efforts(ctx.model, drive))
+        self.update_period = self.controller.update_period
         self.next_odom = 0.0
         self.encoder = EncoderOdometry(drive.wheel_radius, drive.wheel_separation)
-        self._lock = threading.Lock()
-        self._pending = None
         ns = drive.namespace
-        self.cmd_sub = ctx.subscriber(join(ns, drive.command_topic), Twist, self._on_twist, queue_size=1)
+        # Validated here, on rospy's thread: a good command followed by a NaN one keeps the good one, as
+        # diff_drive_controller does; the loop takes the newest at once in real time, at the next step in fast mode.
+        self.cmd_sub = ctx.subscriber(join(ns, drive.command_topic), Twist,
+                                      twist_callback(ctx, self, self.controller.inbox, DRIVE_TWIST), queue_size=1)
         self.odom_pub = ctx.publisher(join(ns, drive.odometry_topic), Odometry) if drive.publish_odom else None
         self.odom_builder = ros_msgs.OdometryBuilder(drive.odometry_frame, drive.robot_base_frame,
                                                      drive.covariance_x, drive.covariance_y, drive.covariance_yaw)
         self.tf_builder = ros_msgs.TransformBuilder(drive.odometry_frame, drive.robot_base_frame)
         self.debug_pub = (ctx.publisher(ctx.private + "debug/cmd_applied", TwistStamped)
                           if cfg.debug_cmd_applied else None)
-
-    # -- callbacks (rospy's threads) ----------------------------------------------------------------
-    def _on_twist(self, msg):
-        """Keep the newest *valid* command and wake the loop, which applies it (at once in real time, at the
-        next step in fast mode). Validating here means a good command followed by a NaN one keeps the good
-        one, as diff_drive_controller does."""
-        values = finite_twist(self.ctx, msg, self)
-        if values is None:
-            return
-        with self._lock:
-            self._pending = values
-        self.ctx.sim.wake.set()
-
-    def _take(self):
-        if self._pending is None:
-            return None
-        with self._lock:
-            twist, self._pending = self._pending, None
-        return twist
 
     # -- loop ---------------------------------------------------------------------------------------
     def joints(self):
@@ -82,33 +62,15 @@ class DiffDrive(Plugin):
         return [p for p in (self.odom_pub, self.debug_pub) if p is not None]
 
     def next_due(self):
-        return self.next_update
+        return self.controller.next_update
 
     def next_publish(self):
         return self.next_odom
 
     def before_step(self, now):
-        twist = self._take()
-        fresh = False
-        if twist is not None:
-            fresh = self.controller.set_command(twist[0], twist[5], now)
-        elif now + 1e-9 < self.next_update:
-            expiry = self.controller.expiry()
-            if expiry is None or now < expiry:
-                return  # nothing new, nothing due: the motors keep their targets
-        robot = self.ctx.robot
-        _, velocities, _ = robot.joint_states(self.wheel_idx)
-        n = len(self.left_idx)
-        left_v = sum(velocities[:n]) / n
-        right_v = sum(velocities[n:]) / n
-        dt = max(now - self.last_update, self.ctx.cfg.time_step)
-        left, right = self.controller.update(now, left_v, right_v, dt)
-        robot.set_velocities(self.wheel_idx, [left] * n + [right] * n, self.wheel_forces)
-        self.last_update = now
-        if now + 1e-9 >= self.next_update:
-            self.next_update = next_due(self.next_update, self.update_period, now)
-        if fresh and self.debug_pub is not None:
-            self.debug_pub.publish(ros_msgs.twist_stamped(rospy.Time.from_sec(time.time()), twist[0], twist[5]))
+        applied = self.controller.before_step(now, self.wheels)
+        if applied is not None and self.debug_pub is not None:
+            self.debug_pub.publish(ros_msgs.twist_stamped(rospy.Time.from_sec(time.time()), *applied))
 
     def after_step(self, now, stamp, transforms):
         if now + 1e-9 < self.next_odom:
@@ -131,15 +93,14 @@ class DiffDrive(Plugin):
             transforms.append(self.tf_builder.build(stamp, position, orientation))
 
     def start(self, now):
-        self.next_update = self.next_odom = now
+        self.controller.start(now)
+        self.next_odom = now
         positions, _, _ = self.ctx.robot.joint_states([self.left_idx[0], self.right_idx[0]])
         self.encoder.reset(positions[0], positions[1], now)
 
     def reset(self, now):
-        self.controller.brake()
-        self.ctx.robot.set_velocities(self.wheel_idx, [0.0] * len(self.wheel_idx), self.wheel_forces)
-        with self._lock:
-            self._pending = None
+        self.controller.reset()
+        self.wheels.brake()
 
     def summary(self):
         params = cfgmod.as_params(self.drive)

@@ -13,11 +13,12 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
 from diffbot_sim.control import force_based_move as fbm
+from diffbot_sim.control.command_inbox import CommandInbox
 from diffbot_sim.description.plugin_tags import plugin_filename
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import PluginNotLoaded
 from diffbot_sim.messages import common as ros_msgs
-from diffbot_sim.plugins.base import PlanarCommandInbox, Plugin, join
+from diffbot_sim.plugins.base import PLANAR_TWIST, Plugin, join, twist_callback
 from diffbot_sim.transforms import quaternion_from_yaw, rotate
 
 #: The gain tags, in the order of the pure module's gains (x, y, yaw).
@@ -48,10 +49,11 @@ class ForceBasedMove(Plugin):
         self.base_frame = ctx.frame(ctx.clean_frame(link, path))
         self.command = (0.0, 0.0, 0.0)
         self.last_command = None  # sim time the last command arrived (None: none since load or reset)
-        self.inbox = PlanarCommandInbox(ctx, self)
+        self.inbox = CommandInbox(ctx.sim.wake.set)  # (vx [m/s], vy [m/s], wz [rad/s]) from cmd_vel
         self._pushed_at = None  # sim time of the step the wrench was last added for (once per step)
         self.odometry = fbm.OdometryIntegrator(cfg.odometry_rate)
-        self.sub = ctx.subscriber(join(ns, cfg.command_topic), Twist, self.inbox.on_twist, queue_size=1)
+        self.sub = ctx.subscriber(join(ns, cfg.command_topic), Twist,
+                                  twist_callback(ctx, self, self.inbox, PLANAR_TWIST), queue_size=1)
         self.pub = ctx.publisher(join(ns, cfg.odometry_topic), Odometry)
         self.builders = {still: ros_msgs.OdometryBuilder(self.odom_frame, self.base_frame, 0, 0, 0, *fbm.covariances(
             0.0 if still else 1.0)) for still in (True, False)}

@@ -15,7 +15,6 @@ does. ``commands/motor_power`` and ``events/cliff|bumper`` need kobuki_msgs, whi
 named once in a warning.
 """
 import math
-import threading
 
 import rospy
 from geometry_msgs.msg import Twist
@@ -23,11 +22,12 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import Empty
 
+from diffbot_sim.control.command_inbox import CommandInbox
 from diffbot_sim.control.kinematics import wheel_speeds
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ModelError
 from diffbot_sim.messages import common as ros_msgs
-from diffbot_sim.plugins.base import Plugin, finite_twist, join
+from diffbot_sim.plugins.base import DRIVE_TWIST, Plugin, join, twist_callback
 from diffbot_sim.plugins.joint_motors import UNLIMITED_EFFORT
 from diffbot_sim.transforms import quaternion_from_yaw
 from diffbot_sim.values import check_bool, check_string, tag_number
@@ -65,12 +65,11 @@ class Kobuki(Plugin):
         self.x = self.y = self.yaw = 0.0
         self.last_time = None
         self._imu_velocity = None  # world velocity of the base frame at the last update (accelerometer)
-        self._lock = threading.Lock()
-        self._pending = None
+        self.inbox = CommandInbox(ctx.sim.wake.set)  # (linear.x [m/s], angular.z [rad/s]) from commands/velocity
         self._reset_odom = False
         prefix = base_prefix.strip("/")
-        self.cmd_sub = ctx.subscriber(join(ns, f"{prefix}/commands/velocity"), Twist, self._on_twist,
-                                        queue_size=1)
+        self.cmd_sub = ctx.subscriber(join(ns, f"{prefix}/commands/velocity"), Twist,
+                                      twist_callback(ctx, self, self.inbox, DRIVE_TWIST), queue_size=1)
         self.reset_sub = ctx.subscriber(join(ns, f"{prefix}/commands/reset_odometry"), Empty,
                                           self._on_reset, queue_size=1)
         self.odom_pub = ctx.publisher(join(ns, "odom"), Odometry)
@@ -87,14 +86,6 @@ class Kobuki(Plugin):
                             "are not simulated (their kobuki_msgs types are not in Debian)")
 
     # -- callbacks ----------------------------------------------------------------------------------
-    def _on_twist(self, msg):
-        values = finite_twist(self.ctx, msg, self)
-        if values is None:
-            return
-        with self._lock:
-            self._pending = (values[0], values[5])
-        self.ctx.sim.wake.set()
-
     def _on_reset(self, _msg):
         self._reset_odom = True
 
@@ -111,9 +102,9 @@ class Kobuki(Plugin):
         return math.inf
 
     def before_step(self, now):
-        if self._pending is not None:
-            with self._lock:
-                (linear, angular), self._pending = self._pending, None
+        command = self.inbox.take()
+        if command is not None:
+            linear, angular = command
             self.wheel_cmd = wheel_speeds(linear, angular, self.separation)
             self.cmd_time = now
         elif self.cmd_time is not None and now - self.cmd_time > self.timeout:
@@ -164,8 +155,7 @@ class Kobuki(Plugin):
         self.x = self.y = self.yaw = 0.0
 
     def reset(self, now):
-        with self._lock:
-            self._pending = None
+        self.inbox.clear()
         self.wheel_cmd, self.cmd_time = (0.0, 0.0), None
         self.ctx.robot.set_velocities(self.idx, [0.0, 0.0], [self.torque] * 2)
         self.start(now)

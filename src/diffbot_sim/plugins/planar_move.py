@@ -24,9 +24,10 @@ import math
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
+from diffbot_sim.control.command_inbox import CommandInbox
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.messages import common as ros_msgs
-from diffbot_sim.plugins.base import PlanarCommandInbox, Plugin, join
+from diffbot_sim.plugins.base import PLANAR_TWIST, Plugin, join, twist_callback
 from diffbot_sim.values import check_bool, check_string, tag_number
 
 #: The most a step's makeup may add to the command: the commanded speed (linear, m/s) and yaw rate (rad/s), each
@@ -56,12 +57,13 @@ class PlanarMove(Plugin):
         self.timeout = timeout if timeout > 0 else ctx.cfg.cmd_vel_timeout
         self.command = (0.0, 0.0, 0.0)
         self.stamp = None
-        self.inbox = PlanarCommandInbox(ctx, self)
+        self.inbox = CommandInbox(ctx.sim.wake.set)  # (vx [m/s], vy [m/s], wz [rad/s]) from cmd_vel
         self.makeup = (0.0, 0.0, 0.0)  # added to the command: what the last step took of the velocity set
         self._set, self._set_at = None, None  # the velocity set before the last step, and when
         mass, inertia = ctx.robot.planar_inertia()
         self.gyration = math.sqrt(inertia / mass) if mass > 0 and inertia > 0 else 1.0  # m
-        self.sub = ctx.subscriber(join(ns, values["commandTopic"]), Twist, self.inbox.on_twist, queue_size=1)
+        self.sub = ctx.subscriber(join(ns, values["commandTopic"]), Twist,
+                                  twist_callback(ctx, self, self.inbox, PLANAR_TWIST), queue_size=1)
         self.pub = ctx.publisher(join(ns, values["odometryTopic"]), Odometry)
         self.builder = ros_msgs.OdometryBuilder(self.odom_frame, self.base_frame, 1e-5, 1e-5, 1e-3)
         self.tf_builder = ros_msgs.TransformBuilder(self.odom_frame, self.base_frame)

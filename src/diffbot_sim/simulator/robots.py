@@ -1,16 +1,17 @@
 """Building bullet_sim's world and robots from its parameters, at start and when one is spawned at run time
 (/gazebo/spawn_urdf_model): each robot's model loaded, its ``<gazebo>`` plugins given to their modules
-(:mod:`diffbot_sim.plugins.registry`), and one start-up report of what was loaded and what was not (rospy)."""
-import os
+(:mod:`diffbot_sim.plugins.registry`), and one start-up report of what was loaded and what was not (rospy).
 
+A model is read and placed as the Gymnasium scene reads and places it: :mod:`diffbot_sim.description.prepared_model`
+and :mod:`diffbot_sim.physics.robot_loading`."""
 import rospy
 
 from diffbot_sim import config as cfgmod
 from diffbot_sim.description import meshes
-from diffbot_sim.description.model_files import load_file, package_path, parse_args
-from diffbot_sim.description.plugin_tags import read_plugins
-from diffbot_sim.description.urdf_model import parse_urdf, tag_value
+from diffbot_sim.description.prepared_model import prepare_model, read_model_file
+from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ModelError
+from diffbot_sim.physics.robot_loading import place_robot
 from diffbot_sim.plugins import registry
 from diffbot_sim.plugins.base import RobotContext, get_param
 from diffbot_sim.simulator.actors import Actors
@@ -22,8 +23,7 @@ def _load_model(spec):
     """URDF text and its source name: the spec's file, else ``/<name>/robot_description``, else the
     ``robot_description`` parameter found from the node's namespace (one model shared by every robot)."""
     if spec.model:
-        path = os.path.abspath(os.path.expanduser(spec.model))
-        return load_file(path, parse_args(spec.model_args)), path
+        return read_model_file(spec.model, spec.model_args)
     name = f"/{spec.name}/robot_description" if spec.name else None
     if name is None or not rospy.has_param(name):
         name = rospy.search_param("robot_description")
@@ -47,20 +47,14 @@ def _build_robot(sim, cfg, spec, params, loaded=None, pose=None, now=None):
     """Load one robot and give each of its plugins to its module. ``loaded``: the URDF text and its source
     name (default: the spec's model); ``pose``: its root link's world pose (default: the spec's x, y, z
     raised onto the world, and yaw); ``now``: the sim time a robot spawned while running starts at."""
-    text, source = loaded or _load_model(spec)
-    model = parse_urdf(text, source)
-    base_dir = os.path.dirname(source) if os.path.isfile(source) else os.getcwd()
-    text, mesh_notes = meshes.prepare_meshes(text, source, base_dir, meshes.default_cache_dir(),
-                                             package_path)
-    found = read_plugins(model, known=registry.KNOWN, known_sensors=registry.KNOWN_SENSORS)
-    for trans in model.transmissions:
-        model.joint(trans.joint, f"/robot/transmission[@name='{trans.name}']")
+    prepared = prepare_model(*(loaded or _load_model(spec)), known=registry.KNOWN,
+                             known_sensors=registry.KNOWN_SENSORS)
+    model, found = prepared.model, prepared.plugins
     if pose is None:
-        z = max(spec.z, sim.world.top_at(spec.x, spec.y)) if sim.world.world_bodies else spec.z
-        robot = sim.world.load_robot(text, model, (spec.x, spec.y, z), spec.yaw)
+        robot = place_robot(sim.world, prepared, spec.x, spec.y, spec.z, spec.yaw)
         namespace = "/" + spec.name if spec.name else None
     else:
-        robot = sim.world.load_robot(text, model, pose[0], orientation=pose[1])
+        robot = sim.world.load_robot(prepared.text, model, pose[0], orientation=pose[1])
         namespace = None  # a spawn request's robot_namespace is already in its plugins' <robotNamespace>
         if spec.tf_prefix is None:
             spec.tf_prefix = _spawned_tf_prefix(model)
@@ -72,7 +66,7 @@ def _build_robot(sim, cfg, spec, params, loaded=None, pose=None, now=None):
         sim.world.remove_robot(robot)
         raise
     sim.add_robot(runtime, now)
-    return LoadedRobot(spec, model, found, runtime, model.warnings + mesh_notes + ctx.warnings)
+    return LoadedRobot(spec, model, found, runtime, model.warnings + prepared.notes + ctx.warnings)
 
 
 def spawn_robot(sim, cfg, params, name, text, source, pose):

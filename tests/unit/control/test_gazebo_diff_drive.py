@@ -1,10 +1,11 @@
-"""controller.py: DiffDriveController — refusal of non-finite commands, clamping, timeout brake,
-acceleration ramp from the measured velocity, curvature kept under saturation."""
+"""control.gazebo_diff_drive: DiffDriveController — refusal of non-finite commands, clamping, timeout brake,
+acceleration ramp from the measured velocity, curvature kept under saturation; the plugin's step (a new
+command at once, updates on the schedule, a stale command braked at its step) and its wheels."""
 import math
 
 import pytest
 
-from diffbot_sim.control.gazebo_diff_drive import TWIST_FIELDS, DiffDriveController, non_finite_field
+from diffbot_sim.control.gazebo_diff_drive import TWIST_FIELDS, DiffDriveController, DriveWheels, non_finite_field
 from diffbot_sim.control.kinematics import body_velocity
 
 SEP, RAD, VMAX = 0.2, 0.032, 40.0  # the seed: max_linear = 1.28 m/s, max angular = 12.8 rad/s
@@ -165,3 +166,85 @@ def test_curvature_kept_when_linear_speed_saturates():
     assert max(abs(t) for t in targets) == pytest.approx(VMAX)
     v, w = body(targets)
     assert v / w == pytest.approx(2.0)
+
+
+# -- the plugin's step: inbox, schedule, timeout between updates (what both front ends run) --------------------
+
+class Wheels:
+    """DriveWheels' interface: measured (left, right) velocities in, the targets set recorded."""
+
+    def __init__(self, left=0.0, right=0.0):
+        self.measured, self.set_to = (left, right), []
+
+    def velocities(self):
+        return self.measured
+
+    def set(self, left, right):
+        self.set_to.append((left, right))
+
+
+def stepper(**kwargs):
+    ctrl = make(update_rate=100.0, time_step=1 / 240, **kwargs)
+    ctrl.start(0.0)
+    return ctrl, Wheels()
+
+
+def test_a_new_command_reaches_the_wheels_at_once_then_updates_follow_the_schedule():
+    ctrl, wheels = stepper()
+    assert ctrl.before_step(0.0, wheels) is None and len(wheels.set_to) == 1  # due at the start
+    assert ctrl.before_step(1 / 240, wheels) is None and len(wheels.set_to) == 1  # not due until 0.01
+    ctrl.inbox.put((0.2, 0.0))
+    assert ctrl.before_step(2 / 240, wheels) == (0.2, 0.0)  # between updates, but new: applied now
+    assert body(wheels.set_to[-1]) == pytest.approx((0.2, 0.0))
+    assert ctrl.before_step(3 / 240, wheels) is None and len(wheels.set_to) == 3  # 0.0125 >= 0.01: due
+    assert ctrl.next_update == pytest.approx(0.02)
+
+
+def test_a_non_finite_command_is_not_applied_and_waits_for_the_schedule():
+    ctrl, wheels = stepper()
+    ctrl.before_step(0.0, wheels)
+    ctrl.inbox.put((math.nan, 0.0))
+    assert ctrl.before_step(1 / 240, wheels) is None and len(wheels.set_to) == 1
+
+
+def test_a_stale_command_brakes_at_its_step_not_at_the_next_update():
+    ctrl, wheels = stepper(cmd_vel_timeout=0.105, max_wheel_acceleration=1.0)
+    ctrl.inbox.put((0.2, 0.0))
+    ctrl.before_step(0.0, wheels)
+    wheels.measured = (6.0, 6.0)
+    step = 1
+    while step * (1 / 240) < 0.105:
+        ctrl.before_step(step / 240, wheels)
+        step += 1
+    count = len(wheels.set_to)
+    ctrl.before_step(step / 240, wheels)  # 0.1083 s: stale, and no update is due before 0.11
+    assert step / 240 < ctrl.next_update
+    assert len(wheels.set_to) == count + 1 and wheels.set_to[-1] == (0.0, 0.0)
+
+
+def test_reset_forgets_a_command_on_its_way_and_stops():
+    ctrl, wheels = stepper()
+    ctrl.inbox.put((0.2, 0.0))
+    ctrl.before_step(0.0, wheels)
+    ctrl.inbox.put((0.3, 0.0))
+    ctrl.reset()
+    ctrl.start(5.0)
+    assert ctrl.before_step(5.0, wheels) is None
+    assert wheels.set_to[-1] == (0.0, 0.0) and (ctrl.linear, ctrl.angular) == (0.0, 0.0)
+
+
+def test_drive_wheels_average_each_side_and_set_every_wheel():
+    class Body:
+        def joint_states(self, indices):
+            assert indices == [1, 2, 3, 4]
+            return None, [1.0, 3.0, -2.0, -4.0], None
+
+        def set_velocities(self, indices, velocities, forces):
+            self.call = (indices, velocities, forces)
+    robot = Body()
+    wheels = DriveWheels(robot, [1, 2], [3, 4], [5.0, 5.0, 6.0, 6.0])
+    assert wheels.velocities() == (2.0, -3.0)
+    wheels.set(0.5, -0.5)
+    assert robot.call == ([1, 2, 3, 4], [0.5, 0.5, -0.5, -0.5], [5.0, 5.0, 6.0, 6.0])
+    wheels.brake()
+    assert robot.call[1] == [0.0] * 4

@@ -115,7 +115,7 @@ def test_an_action_is_held_for_exactly_one_control_period(env):
     step = scene.world.step
 
     def counted_step():
-        commands.append((scene.drive.controller.linear, scene.drive.controller.angular))
+        commands.append((scene.drive.core.linear, scene.drive.core.angular))
         step()
 
     scene.world.step = counted_step

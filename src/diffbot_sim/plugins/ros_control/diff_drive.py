@@ -2,12 +2,11 @@
 ``<controller>/odom`` out, ``/tf`` when ``enable_odom_tf``, ``<controller>/cmd_vel_out`` when ``publish_cmd``;
 geometry from the URDF where the YAML gives none (first left/right joint origins, the first left wheel's
 cylinder or sphere collision). The controller's logic is :mod:`diffbot_sim.control.diff_drive_controller`."""
-import threading
-
 from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 
 from diffbot_sim.control import diff_drive_config as ddc_cfg
+from diffbot_sim.control.command_inbox import CommandInbox
 from diffbot_sim.control.diff_drive_controller import DiffDriveControllerCore
 from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import join
@@ -39,8 +38,7 @@ class DiffDriveController(Controller):
         self.cfg = cfg
         self.odom_frame = ctx.frame(cfg.odom_frame_id)
         self.base_frame = ctx.frame(cfg.base_frame_id)
-        self._lock = threading.Lock()
-        self._pending = None
+        self.inbox = CommandInbox(ctx.sim.wake.set)  # (linear.x, angular.z, publishers of cmd_vel then)
         self.sub = self.own(ctx.subscriber(join(name, "cmd_vel"), Twist, self._on_twist, queue_size=1))
         self.odom_pub = self.own(ctx.publisher(join(name, "odom"), Odometry))
         self.cmd_out_pub = (self.own(ctx.publisher(join(name, "cmd_vel_out"), TwistStamped)) if cfg.publish_cmd
@@ -51,10 +49,7 @@ class DiffDriveController(Controller):
         self.tf_builder = ros_msgs.TransformBuilder(self.odom_frame, self.base_frame)
 
     def _on_twist(self, msg):
-        count = self.sub.get_num_connections()
-        with self._lock:
-            self._pending = (msg.linear.x, msg.angular.z, count)
-        self.ctx.sim.wake.set()
+        self.inbox.put((msg.linear.x, msg.angular.z, self.sub.get_num_connections()))
 
     def joints(self):
         return set(self.cfg.joints)
@@ -73,9 +68,9 @@ class DiffDriveController(Controller):
             self.hw.set_command(joint, 0.0)
 
     def update(self, now, period, stamp, transforms):
-        if self._pending is not None:
-            with self._lock:
-                (linear, angular, count), self._pending = self._pending, None
+        command = self.inbox.take()
+        if command is not None:
+            linear, angular, count = command
             why = self.core.set_command(linear, angular, now, count)
             if why is not None:
                 self.ctx.sim.warn(f"ddc:{self.name}", f"{self.name}: {why}")

@@ -6,12 +6,12 @@
 ``control_msgs/JointControllerState`` on ``<controller>/state`` every 10th update. The mathematics is
 :mod:`diffbot_sim.control.forward_command`."""
 import math
-import threading
 
 import rospy
 from std_msgs.msg import Float64, Float64MultiArray
 
 from diffbot_sim.control import forward_command as fwd
+from diffbot_sim.control.command_inbox import CommandInbox
 from diffbot_sim.messages import controllers as control_messages
 from diffbot_sim.plugins.base import join
 from diffbot_sim.plugins.ros_control.controller import Controller
@@ -31,8 +31,7 @@ class ForwardCommandController(Controller):
         #: PID controllers close their loop in software: they run every physics step, as at Gazebo's default
         #: controlPeriod (forwarding ones only pass a value on, and run at the manager's period).
         self.closed_loop = self.cfg.kind.startswith("pid_")
-        self._lock = threading.Lock()
-        self._pending = None
+        self.inbox = CommandInbox(ctx.sim.wake.set)  # the newest finite command message's data
         kind = Float64 if self.cfg.single else Float64MultiArray
         self.sub = self.own(ctx.subscriber(join(name, "command"), kind, self._on_command, queue_size=1))
         self.state_pub = None
@@ -48,9 +47,7 @@ class ForwardCommandController(Controller):
         if not all(math.isfinite(v) for v in (values if isinstance(values, (list, tuple)) else [values])):
             self.ctx.sim.warn(f"cmd:{self.name}", f"{self.name}: ignored a command with a non-finite value")
             return
-        with self._lock:
-            self._pending = values
-        self.ctx.sim.wake.set()
+        self.inbox.put(values)
 
     def joints(self):
         return set(self.cfg.joints)
@@ -65,9 +62,8 @@ class ForwardCommandController(Controller):
                     if not self.closed_loop else [0.0] * len(self.cfg.joints))
 
     def update(self, now, period, stamp, transforms):
-        if self._pending is not None:
-            with self._lock:
-                values, self._pending = self._pending, None
+        values = self.inbox.take()
+        if values is not None:
             error = self.core.command(values)
             if error is not None:
                 rospy.logerr(f"{self.name}: {error}")
