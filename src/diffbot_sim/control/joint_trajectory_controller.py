@@ -5,7 +5,8 @@ JointTrajectoryController`` from their YAML and drive it with MoveIt (``follow_j
 ``command`` messages. This module reproduces what the controller does with them, read from
 ``joint_trajectory_controller_impl.h``, ``hardware_interface_adapter.h`` and ``tolerances.h``:
 
-- :func:`jtc_config`: ``init()``'s parameters with their defaults, checked once into :class:`JtcConfig`.
+- :class:`JtcConfig` (:mod:`diffbot_sim.control.joint_trajectory_config`): ``init()``'s parameters with their
+  defaults, checked once.
 - :class:`JointTrajectoryControllerCore`: ``starting`` (hold at the measured state), ``update`` (sample the
   trajectory at the controller's uptime, check the active goal's path/goal tolerances, compute the
   hardware command, decide whether ``state`` is due), ``goal`` / ``cancel`` (``goalCB`` / ``cancelCB`` with
@@ -20,16 +21,14 @@ message is read against the *next* update (last update's time + period), whateve
 the ``time`` arguments of ``goal``/``command``/``cancel``/``stopping`` do not move anything (kept for the
 caller's symmetry); ``query_state``'s ``time`` is the requested sample time.
 """
-from dataclasses import dataclass
 from typing import Hashable, NamedTuple, Optional, Tuple
 
 from diffbot_sim.control.angles import shortest_angular_distance
-from diffbot_sim.control.pid import Pid, PidGains, no_p_gain_message, pid_gains
-from diffbot_sim.control.trajectory import (SegmentTolerances, StateTolerances, TrajectoryError, hold_trajectory,
-                                            joint_mapping, merge_trajectory, resolve_goal_tolerances, sample,
-                                            to_ns, to_sec)
-from diffbot_sim.errors import ConfigError, DiffbotSimError
-from diffbot_sim.values import check_bool, check_number
+from diffbot_sim.control.joint_trajectory_config import JtcConfig
+from diffbot_sim.control.pid import Pid
+from diffbot_sim.control.trajectory import (TrajectoryError, hold_trajectory, joint_mapping, merge_trajectory,
+                                            resolve_goal_tolerances, sample, to_ns, to_sec)
+from diffbot_sim.errors import DiffbotSimError
 
 # control_msgs/FollowJointTrajectoryResult error codes.
 SUCCESSFUL = 0
@@ -39,144 +38,13 @@ OLD_HEADER_TIMESTAMP = -3  # never returned by this controller (a past trajector
 PATH_TOLERANCE_VIOLATED = -4
 GOAL_TOLERANCE_VIOLATED = -5
 
-CONTROLLER_TYPES = {
-    "position_controllers/JointTrajectoryController": "position",
-    "velocity_controllers/JointTrajectoryController": "velocity",
-    "effort_controllers/JointTrajectoryController": "effort",
-    # PosVel / PosVelAcc interfaces take the desired position (and velocity / acceleration) as they are.
-    "pos_vel_controllers/JointTrajectoryController": "position",
-    "pos_vel_acc_controllers/JointTrajectoryController": "position",
-}
-
 NOT_RUNNING = "Can't accept new commands. Controller is not running."
 GOAL_NOT_RUNNING = "Can't accept new action goals. Controller is not running."
 GOAL_WRONG_JOINTS = "Joints on incoming goal don't match the controller joints."
-NO_GAINS_WARNING = "Failed to initialize PID gains from ROS parameter server."
 
 
 class ControllerCrash(DiffbotSimError):
     """Upstream would crash the controller manager's process here (Gazebo dies); the message says why."""
-
-
-@dataclass(frozen=True)
-class JtcConfig:
-    """A JointTrajectoryController's parameters, checked, with upstream's defaults.
-
-    ``default_tolerances`` is one :class:`SegmentTolerances` per joint (``constraints/``). ``gains`` and
-    ``velocity_ff`` are read for the velocity/effort variants only. ``log`` holds ``(level, text)`` lines
-    upstream prints while loading; ``start_crash`` is set when upstream loads the controller but would crash
-    on starting it (closed-loop variant without gains for a joint).
-    """
-
-    name: str
-    controller_type: str
-    variant: str
-    joints: Tuple[str, ...]
-    wraparound: Tuple[bool, ...]
-    default_tolerances: Tuple[SegmentTolerances, ...]
-    state_publish_rate: float = 50.0
-    action_monitor_rate: float = 20.0
-    stop_trajectory_duration: float = 0.0
-    allow_partial_joints_goal: bool = False
-    gains: Tuple[PidGains, ...] = ()
-    velocity_ff: Tuple[float, ...] = ()
-    log: Tuple[Tuple[str, str], ...] = ()
-    start_crash: Optional[str] = None
-
-
-def jtc_config(params, name, joints):
-    """The :class:`JtcConfig` of the controller whose rosparam dict is ``params``.
-
-    Args:
-        params: ``rospy.get_param(name)``: ``type``, ``joints``, ``constraints``, ``gains``, ...
-        name: the controller's full namespace (e.g. ``/arm_controller``), for messages.
-        joints: the URDF's joints, name → (type, lower, upper); ``continuous`` joints wrap around.
-
-    Raises:
-        ConfigError: an unknown type, a missing/empty/non-string ``joints`` list, a joint the URDF lacks, or
-            a parameter of the wrong kind, naming the full parameter.
-    """
-    if not isinstance(params, dict):
-        raise ConfigError(name, params, "a dictionary of controller parameters")
-    controller_type = params.get("type")
-    if controller_type not in CONTROLLER_TYPES:
-        raise ConfigError(f"{name}/type", controller_type, "one of " + ", ".join(CONTROLLER_TYPES))
-    joint_names = _joint_names(params.get("joints"), f"{name}/joints", joints)
-    constraints = _sub_dict(params, "constraints", name)
-    stopped_velocity = check_number(f"{name}/constraints/stopped_velocity_tolerance",
-                                    constraints.get("stopped_velocity_tolerance", 0.01))
-    goal_time = check_number(f"{name}/constraints/goal_time", constraints.get("goal_time", 0.0))
-    tolerances = []
-    for joint in joint_names:
-        own = _sub_dict(constraints, joint, f"{name}/constraints")
-        path = check_number(f"{name}/constraints/{joint}/trajectory", own.get("trajectory", 0.0))
-        goal = check_number(f"{name}/constraints/{joint}/goal", own.get("goal", 0.0))
-        tolerances.append(SegmentTolerances(StateTolerances(position=path),
-                                            StateTolerances(position=goal, velocity=stopped_velocity), goal_time))
-    variant = CONTROLLER_TYPES[controller_type]
-    gains, velocity_ff, log, start_crash = (), (), (), None
-    if variant != "position":
-        gains, velocity_ff, log, start_crash = _closed_loop_gains(params, name, joint_names, controller_type)
-    return JtcConfig(
-        name=name, controller_type=controller_type, variant=variant, joints=joint_names,
-        wraparound=tuple(joints[joint][0] == "continuous" for joint in joint_names),
-        default_tolerances=tuple(tolerances),
-        state_publish_rate=check_number(f"{name}/state_publish_rate", params.get("state_publish_rate", 50.0),
-                                        low=0.0, low_open=True),
-        action_monitor_rate=check_number(f"{name}/action_monitor_rate", params.get("action_monitor_rate", 20.0),
-                                         low=0.0, low_open=True),
-        stop_trajectory_duration=check_number(f"{name}/stop_trajectory_duration",
-                                              params.get("stop_trajectory_duration", 0.0), low=0.0),
-        allow_partial_joints_goal=check_bool(f"{name}/allow_partial_joints_goal",
-                                             params.get("allow_partial_joints_goal", False)),
-        gains=gains, velocity_ff=velocity_ff, log=log, start_crash=start_crash)
-
-
-def _joint_names(value, label, urdf_joints):
-    expected = "a non-empty list of joint names"
-    if not isinstance(value, (list, tuple)) or not value or not all(isinstance(j, str) for j in value):
-        raise ConfigError(label, value, expected)
-    for joint in value:
-        if joint not in urdf_joints:
-            raise ConfigError(label, joint, "joints of robot_description (upstream: Could not find joint "
-                                            f"'{joint}' in URDF model.)")
-    return tuple(value)
-
-
-def _sub_dict(params, key, parent):
-    value = params.get(key)
-    if value is None:
-        return {}
-    if not isinstance(value, dict):
-        raise ConfigError(f"{parent}/{key}", value, "a dictionary")
-    return value
-
-
-def _closed_loop_gains(params, name, joint_names, controller_type):
-    """``ClosedLoopHardwareInterfaceAdapter::init``: a PID per joint from ``gains/<joint>``, then
-    ``velocity_ff/<joint>`` (default 0).
-
-    Upstream stops at the first joint without ``p`` (ROS_ERROR + ROS_WARN, ``init`` returns false), but the
-    controller ignores that result and loads. The later joints' PIDs are then null pointers, which
-    ``starting()`` dereferences, and ``velocity_ff`` is left empty, which the first ``update()`` indexes:
-    the process dies when the controller starts. That is reported in ``start_crash``.
-    """
-    all_gains = _sub_dict(params, "gains", name)
-    feed_forward = _sub_dict(params, "velocity_ff", name)
-    gains = []
-    for joint in joint_names:
-        namespace = f"{name}/gains/{joint}"
-        joint_gains = pid_gains(all_gains.get(joint), namespace)
-        if joint_gains is None:
-            log = (("error", no_p_gain_message(namespace)), ("warn", NO_GAINS_WARNING))
-            crash = (f"{name}: {controller_type} has no PID gains for joint '{joint}' ({namespace}/p); "
-                     "ros_controllers loads it anyway and crashes the controller manager's process (Gazebo) "
-                     "as soon as it starts (null PID / empty velocity_ff in HardwareInterfaceAdapter)")
-            return tuple(gains), (), log, crash
-        gains.append(joint_gains)
-    velocity_ff = tuple(check_number(f"{name}/velocity_ff/{joint}", feed_forward.get(joint, 0.0))
-                        for joint in joint_names)
-    return tuple(gains), velocity_ff, (), None
 
 
 class TrajectoryState(NamedTuple):

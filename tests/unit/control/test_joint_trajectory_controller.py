@@ -1,15 +1,16 @@
-"""joint_trajectory_controller: parameters, the per-update core and its action/topic/service answers, run
-closed loop against simulated joints (a position interface that reaches each command one update later, and a
-double integrator driven by effort), at a fixed 0.01 s control period from sim time 100 s.
+"""joint_trajectory_controller: parameters (joint_trajectory_config), the per-update core and its
+action/topic/service answers, run closed loop against simulated joints (a position interface that reaches each
+command one update later, and a double integrator driven by effort), at a fixed 0.01 s control period from sim
+time 100 s.
 """
 import math
 
 import pytest
 
 from diffbot_sim.control import joint_trajectory_controller as jtc
-from diffbot_sim.control.joint_trajectory_controller import (ControllerCrash, JointTrajectoryControllerCore,
-                                                             jtc_config)
 from diffbot_sim.control import trajectory as tr
+from diffbot_sim.control.joint_trajectory_config import jtc_config
+from diffbot_sim.control.joint_trajectory_controller import ControllerCrash, JointTrajectoryControllerCore
 from diffbot_sim.control.trajectory import TrajectoryPoint as P
 from diffbot_sim.errors import ConfigError
 

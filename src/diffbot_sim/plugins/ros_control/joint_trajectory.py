@@ -19,6 +19,7 @@ import rospy
 from trajectory_msgs.msg import JointTrajectory
 
 from diffbot_sim.control import joint_trajectory_controller as jtc
+from diffbot_sim.control.joint_trajectory_config import jtc_config
 from diffbot_sim.errors import ConfigError
 from diffbot_sim.messages import controllers as cm
 from diffbot_sim.plugins.base import join, next_due
@@ -33,7 +34,7 @@ class JointTrajectoryController(Controller):
         super().__init__(ctx, hw, name, params)
         msg, srv = cm.control_msgs()
         self.type = params.get("type")
-        self.cfg = jtc.jtc_config(params, name, self.urdf_joints())
+        self.cfg = jtc_config(params, name, self.urdf_joints())
         self.interface = INTERFACES[self.cfg.variant]
         for joint in self.cfg.joints:
             self.require_interface(joint, self.interface)

@@ -19,7 +19,7 @@ from diffbot_sim.control import diff_drive_config as ddc_cfg
 from diffbot_sim.control import forward_command as fwd
 from diffbot_sim.control import four_wheel_steering_controller as fws
 from diffbot_sim.control import gripper_action_controller as gac
-from diffbot_sim.control import joint_trajectory_controller as jtc
+from diffbot_sim.control import joint_trajectory_config as jtc_cfg
 from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.plugins.base import get_param, join
 from diffbot_sim.plugins.ros_control.ackermann_steering import AckermannSteeringController
@@ -44,7 +44,7 @@ def _factories():
                                                                                                params)}
     for kind in fwd.CONTROLLER_TYPES:
         table[kind] = lambda ctx, hw, name, params, ns: ForwardCommandController(ctx, hw, name, params)
-    for kind in jtc.CONTROLLER_TYPES:
+    for kind in jtc_cfg.CONTROLLER_TYPES:
         table[kind] = lambda ctx, hw, name, params, ns: JointTrajectoryController(ctx, hw, name, params)
     for kind in (gac.POSITION_TYPE, gac.EFFORT_TYPE):
         table[kind] = lambda ctx, hw, name, params, ns: GripperActionController(ctx, hw, name, params)
