@@ -61,7 +61,7 @@ class SimConfig:
 
 
 @dataclass
-class DriveConfig:
+class GazeboDiffDriveConfig:
     """The diff drive, as gazebo_ros_diff_drive defines it (ROS 1 defaults), after tags and parameters."""
 
     left_joints: List[str] = field(default_factory=lambda: ["left_joint"])
@@ -89,7 +89,7 @@ class DriveConfig:
         return self.wheel_diameter / 2.0
 
 
-#: gazebo_ros_skid_steer_drive (ROS 1): its tags as DriveConfig keys, and the defaults that differ from the
+#: gazebo_ros_skid_steer_drive (ROS 1): its tags as GazeboDiffDriveConfig keys, and the defaults that differ from the
 #: diff drive's (it broadcasts no TF unless asked, always reports the world pose, has no acceleration limit).
 SKID_STEER_TAGS = {
     "leftFrontJoint": "left_front", "leftRearJoint": "left_rear", "rightFrontJoint": "right_front",
@@ -106,17 +106,17 @@ SKID_STEER_DEFAULTS = {"left_front": "left_front_joint", "left_rear": "left_rear
 
 
 def skid_steer_config(model, values, path, notes=None):
-    """DriveConfig of a gazebo_ros_skid_steer_drive block: ``values`` maps its tags to their texts.
+    """GazeboDiffDriveConfig of a gazebo_ros_skid_steer_drive block: ``values`` maps its tags to their texts.
 
     Raises:
-        ConfigError, ModelError: as :func:`drive_config`.
+        ConfigError, ModelError: as :func:`gazebo_diff_drive_config`.
     """
     notes = notes if notes is not None else []
     merged = dict(SKID_STEER_DEFAULTS)
     for tag, text in values.items():
         if tag in SKID_STEER_TAGS:
             merged[SKID_STEER_TAGS[tag]] = text
-    cfg = DriveConfig(odometry_source="world")
+    cfg = GazeboDiffDriveConfig(odometry_source="world")
     tag_of = {key: tag for tag, key in SKID_STEER_TAGS.items()}
     for key, value in merged.items():
         label = f"<{tag_of.get(key, key)}> of {path}"
@@ -220,8 +220,8 @@ def sim_config(params):
     return cfg
 
 
-def drive_config(model, block, params, notes=None):
-    """Merge defaults, the diff-drive plugin block (may be None) and private params into a DriveConfig.
+def gazebo_diff_drive_config(model, block, params, notes=None):
+    """Merge defaults, the diff-drive plugin block (may be None) and private params into a GazeboDiffDriveConfig.
 
     Wheel separation and diameter missing from both are taken from the URDF. Returns None when neither the
     model nor the parameters describe a drive.
@@ -233,10 +233,10 @@ def drive_config(model, block, params, notes=None):
     Values Gazebo tolerates with a warning (``odometrySource ENCODER``) append it to ``notes`` when given.
     """
     notes = notes if notes is not None else []
-    given = {k: v for k, v in params.items() if k in {f.name for f in fields(DriveConfig)}}
+    given = {k: v for k, v in params.items() if k in {f.name for f in fields(GazeboDiffDriveConfig)}}
     if block is None and "left_joints" not in given:
         return None
-    cfg = DriveConfig()
+    cfg = GazeboDiffDriveConfig()
     if block is not None and block.dialect == "ros2":
         for key, value in ROS2_DRIVE_DEFAULTS.items():
             setattr(cfg, key, value)
@@ -413,7 +413,7 @@ def as_params(cfg):
 
 
 def _drive_value(key, value, label, notes, from_tag=False):
-    """``value`` of DriveConfig field ``key``, validated; a value Gazebo tolerates with a warning appends
+    """``value`` of GazeboDiffDriveConfig field ``key``, validated; a value Gazebo tolerates with a warning appends
     that warning to ``notes``. A number ``from_tag`` (a plugin tag's text) is read as Gazebo reads it: its
     leading number (:func:`diffbot_sim.values.tag_number`)."""
     def number(**limits):

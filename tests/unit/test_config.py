@@ -1,4 +1,4 @@
-"""config.py: SimConfig, DriveConfig and JointStateConfig from defaults, plugin tags and private params."""
+"""config.py: SimConfig, GazeboDiffDriveConfig and JointStateConfig from defaults, plugin tags and private params."""
 import math
 import os
 
@@ -9,7 +9,7 @@ from diffbot_sim.config import (
     FALLBACK_MAX_WHEEL_VELOCITY,
     SimConfig,
     as_params,
-    drive_config,
+    gazebo_diff_drive_config,
     joint_state_config,
     sim_config,
 )
@@ -27,7 +27,7 @@ def _gazebo(*plugins):
 def _drive(parse, make_urdf, plugin=None, params=None, **urdf):
     gazebo = _gazebo(plugin) if plugin else ""
     model = parse(make_urdf(gazebo=gazebo, **urdf))
-    return drive_config(model, read_plugins(model).diff_drive, params or {})
+    return gazebo_diff_drive_config(model, read_plugins(model).diff_drive, params or {})
 
 
 def _ros2(body, ros=""):
@@ -44,7 +44,7 @@ def _ros1(body):
 
 def test_seed_drive_config(seed_model):
     plugins = read_plugins(seed_model)
-    cfg = drive_config(seed_model, plugins.diff_drive, {})
+    cfg = gazebo_diff_drive_config(seed_model, plugins.diff_drive, {})
     assert cfg.left_joints == ["left_wheel_joint"] and cfg.right_joints == ["right_wheel_joint"]
     assert cfg.wheel_separation == pytest.approx(0.2)
     assert cfg.wheel_diameter == pytest.approx(0.064)
@@ -62,7 +62,7 @@ def test_seed_drive_config(seed_model):
 
 def test_seed_joint_state_config(seed_model):
     plugins = read_plugins(seed_model)
-    drive = drive_config(seed_model, plugins.diff_drive, {})
+    drive = gazebo_diff_drive_config(seed_model, plugins.diff_drive, {})
     cfg = joint_state_config(seed_model, plugins.joint_state, drive)
     assert cfg.joints == ["left_wheel_joint", "right_wheel_joint", "front_caster_joint", "back_caster_joint"]
     assert cfg.update_rate == 100.0 and cfg.topic == "joint_states" and cfg.namespace == "/"
@@ -90,7 +90,7 @@ def test_ros1_block_maps_to_config(parse, make_urdf):
 def test_ros1_publish_wheel_joint_state_feeds_joint_state_config(parse, make_urdf):
     model = parse(make_urdf(gazebo=_gazebo(ROS1_DIFF_DRIVE)))
     plugins = read_plugins(model)
-    drive = drive_config(model, plugins.diff_drive, {})
+    drive = gazebo_diff_drive_config(model, plugins.diff_drive, {})
     cfg = joint_state_config(model, plugins.joint_state, drive)
     assert cfg.joints == ["left_wheel_joint", "right_wheel_joint"]
     assert cfg.update_rate == 50.0 and cfg.namespace == "/bot1"
@@ -99,7 +99,8 @@ def test_ros1_publish_wheel_joint_state_feeds_joint_state_config(parse, make_urd
 def test_no_joint_state_without_plugin_or_flag(parse, make_urdf):
     model = parse(make_urdf(gazebo=_gazebo(_ros1(""))))
     plugins = read_plugins(model)
-    assert joint_state_config(model, plugins.joint_state, drive_config(model, plugins.diff_drive, {})) is None
+    drive = gazebo_diff_drive_config(model, plugins.diff_drive, {})
+    assert joint_state_config(model, plugins.joint_state, drive) is None
 
 
 def test_ros1_publish_tf_false_turns_off_odom_and_its_tf(parse, make_urdf):
@@ -114,7 +115,7 @@ def test_plugin_tag_numbers_are_read_as_gazebo_reads_them(parse, make_urdf):
     notes = []
     model = parse(make_urdf(gazebo=_gazebo(_ros1("<wheelSeparation>0.31m</wheelSeparation>"
                                                  "<updateRate>50.0 Hz</updateRate>"))))
-    cfg = drive_config(model, read_plugins(model).diff_drive, {}, notes)
+    cfg = gazebo_diff_drive_config(model, read_plugins(model).diff_drive, {}, notes)
     assert (cfg.wheel_separation, cfg.update_rate) == (0.31, 50.0)
     assert len(notes) == 2 and all("as Gazebo's SDF reader (std::stod) does" in n for n in notes)
     assert any(n.startswith("<wheelSeparation> of /robot/gazebo[1]/plugin[@name='dd']: took 0.31 from '0.31m'")
@@ -163,7 +164,7 @@ def test_private_params_override_tags(seed_model):
     params = {"wheel_separation": 0.25, "max_wheel_torque": "8", "publish_odom_tf": False,
               "odometry_source": "encoder", "command_topic": "other_cmd", "namespace": "",
               "time_step": 0.001}  # a sim param: ignored here
-    cfg = drive_config(seed_model, read_plugins(seed_model).diff_drive, params)
+    cfg = gazebo_diff_drive_config(seed_model, read_plugins(seed_model).diff_drive, params)
     assert cfg.wheel_separation == 0.25
     assert cfg.max_wheel_torque == 8.0
     assert cfg.publish_odom_tf is False
@@ -175,8 +176,9 @@ def test_private_params_override_tags(seed_model):
 
 def test_params_alone_describe_a_drive(parse, make_urdf):
     model = parse(make_urdf())
-    assert drive_config(model, None, {}) is None
-    cfg = drive_config(model, None, {"left_joints": "left_wheel_joint", "right_joints": ["right_wheel_joint"]})
+    assert gazebo_diff_drive_config(model, None, {}) is None
+    cfg = gazebo_diff_drive_config(model, None, {"left_joints": "left_wheel_joint",
+                                                 "right_joints": ["right_wheel_joint"]})
     assert cfg.left_joints == ["left_wheel_joint"] and cfg.right_joints == ["right_wheel_joint"]
     assert cfg.wheel_separation == pytest.approx(0.3) and cfg.wheel_diameter == pytest.approx(0.1)
 
@@ -229,7 +231,7 @@ def test_bad_ros2_tag_values(parse, make_urdf, body, tag, value):
 ])
 def test_bad_param_values(seed_model, key, value):
     with pytest.raises(ConfigError) as info:
-        drive_config(seed_model, read_plugins(seed_model).diff_drive, {key: value})
+        gazebo_diff_drive_config(seed_model, read_plugins(seed_model).diff_drive, {key: value})
     assert f"parameter ~{key}:" in str(info.value)
 
 
@@ -256,7 +258,7 @@ def test_plugin_naming_missing_joint(parse, make_urdf):
 
 def test_param_naming_missing_joint(seed_model):
     with pytest.raises(ModelError) as info:
-        drive_config(seed_model, read_plugins(seed_model).diff_drive, {"right_joints": "rear_wheel_joint"})
+        gazebo_diff_drive_config(seed_model, read_plugins(seed_model).diff_drive, {"right_joints": "rear_wheel_joint"})
     assert "rear_wheel_joint" in str(info.value)
 
 
@@ -302,7 +304,7 @@ def test_model_with_camera_and_unknown_plugin_still_configures(parse, make_urdf)
               '</sensor></gazebo>')
     model = parse(make_urdf(gazebo=camera + _gazebo(_ros1(""), '<plugin name="x" filename="libmystery.so"/>')))
     plugins = read_plugins(model)
-    cfg = drive_config(model, plugins.diff_drive, {})
+    cfg = gazebo_diff_drive_config(model, plugins.diff_drive, {})
     assert cfg.left_joints == ["left_wheel_joint"]
     assert sorted(plugins.unsupported) == ["plugin x (libmystery.so)", "sensor cam (type camera)"]
 
@@ -352,7 +354,7 @@ def _seed_drive():
     from diffbot_sim.description.urdf_model import parse_urdf
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     model = parse_urdf(load_file(os.path.join(root, "urdf", "diffbot.urdf.xacro")))
-    return model, config.drive_config(model, read_plugins(model).diff_drive, {})
+    return model, config.gazebo_diff_drive_config(model, read_plugins(model).diff_drive, {})
 
 
 def test_max_wheel_velocity_precedence():
@@ -376,7 +378,7 @@ def test_unmatched_odometry_source_warns_and_uses_world(parse, make_urdf, text):
     """gazebo_ros_diff_drive matches 'encoder' and 'world' exactly; anything else warns and uses world."""
     model = parse(make_urdf(gazebo=_gazebo(_ros1(f"<odometrySource>{text}</odometrySource>"))))
     notes = []
-    cfg = drive_config(model, read_plugins(model).diff_drive, {}, notes)
+    cfg = gazebo_diff_drive_config(model, read_plugins(model).diff_drive, {}, notes)
     assert cfg.odometry_source == "world"
     assert len(notes) == 1 and "<odometrySource>" in notes[0] and text in notes[0]
 

@@ -2,7 +2,7 @@
 import pytest
 
 from diffbot_sim.config import (
-    DriveConfig,
+    GazeboDiffDriveConfig,
     JointStateConfig,
     RobotSpec,
     SimConfig,
@@ -58,23 +58,24 @@ def test_prefix_frame_follows_robot_state_publisher():
 
 
 def test_a_named_robot_moves_its_endpoints_and_frames():
-    drive, joints = DriveConfig(namespace="/", odometry_frame="odom"), JointStateConfig(joints=["a"], namespace="/")
+    drive = GazeboDiffDriveConfig(namespace="/", odometry_frame="odom")
+    joints = JointStateConfig(joints=["a"], namespace="/")
     place_in_namespace(RobotSpec(name="robot1"), drive, joints)
     assert drive.namespace == "/robot1" and joints.namespace == "/robot1"
     assert (drive.odometry_frame, drive.robot_base_frame) == ("robot1/odom", "robot1/base_footprint")
 
 
 def test_tf_prefix_overrides_and_empty_prefix_keeps_frames():
-    drive = DriveConfig()
+    drive = GazeboDiffDriveConfig()
     place_in_namespace(RobotSpec(name="robot1", tf_prefix="r1"), drive, None)
     assert drive.odometry_frame == "r1/odom"
-    drive = DriveConfig()
+    drive = GazeboDiffDriveConfig()
     place_in_namespace(RobotSpec(name="robot1", tf_prefix=""), drive, None)
     assert (drive.namespace, drive.odometry_frame) == ("/robot1", "odom")
 
 
 def test_the_unnamed_robot_is_left_alone():
-    drive = DriveConfig(namespace="/ns")
+    drive = GazeboDiffDriveConfig(namespace="/ns")
     place_in_namespace(RobotSpec(), drive, None)
     assert (drive.namespace, drive.odometry_frame) == ("/ns", "odom")
 

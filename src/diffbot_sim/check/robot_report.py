@@ -281,7 +281,7 @@ def _measured_separation(left, right):
 
 
 def _diff_drive(model, block, notes):
-    cfg = cfgmod.drive_config(model, block, {}, notes)
+    cfg = cfgmod.gazebo_diff_drive_config(model, block, {}, notes)
     left, right = cfg.left_joints[0], cfg.right_joints[0]
     sep_from = (f"<{block.tag('wheel_separation')}> tag" if "wheel_separation" in block.values
                 else _measured_separation(left, right))
@@ -315,7 +315,7 @@ def _kobuki(values, path):
 
 def _ddc(model, name, params, file):
     """A DiffDriveController: its drive and the warnings bullet_sim logs for it."""
-    cfg = ddc.ddc_config(params, name)
+    cfg = ddc.diff_drive_controller_config(params, name)
     notes = list(cfg.warnings)
     if cfg.unknown_keys:
         notes.append(f"{name}: parameters DiffDriveController does not read, ignored: {', '.join(cfg.unknown_keys)}")

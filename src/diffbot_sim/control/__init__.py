@@ -1,2 +1,3 @@
-"""The controllers' mathematics: gazebo_ros_diff_drive's controller, ros_controllers'
-DiffDriveController, controller lookup and switching, odometry, kinematics, limits. Pure."""
+"""The controllers' mathematics: gazebo_ros_diff_drive's per-step core (``GazeboDiffDriveCore``), ros_controllers'
+DiffDriveController (``DiffDriveControllerCore``) and its other controllers, the command inbox, controller lookup
+and switching, odometry, kinematics, limits. Pure."""

@@ -1,11 +1,12 @@
 """ros_controllers' diff_drive_controller/DiffDriveController (noetic): its parameters, checked (pure).
 
 A robot built for Gazebo + gazebo_ros_control loads a DiffDriveController from its YAML; to run it unchanged
-the simulator must read the same parameters with the same defaults and precedence. ``ddc_config`` turns the
-controller's parameter dict (``rospy.get_param('/mobile_base_controller')``) into a validated, frozen
-``DdcConfig``: a wrong value raises ``ConfigError`` naming the full parameter, keys upstream never reads are
-listed for one warning, defaults substituted where upstream would fail are said in ``warnings``. The
-controller that runs on it is :mod:`diffbot_sim.control.diff_drive_controller`.
+the simulator must read the same parameters with the same defaults and precedence.
+``diff_drive_controller_config`` turns the controller's parameter dict
+(``rospy.get_param('/mobile_base_controller')``) into a validated, frozen ``DiffDriveControllerConfig``: a wrong
+value raises ``ConfigError`` naming the full parameter, keys upstream never reads are listed for one warning,
+defaults substituted where upstream would fail are said in ``warnings``. The controller that runs on it is
+:mod:`diffbot_sim.control.diff_drive_controller`.
 """
 import math
 from dataclasses import asdict, dataclass, field
@@ -52,7 +53,7 @@ class AxisLimits:
 
 
 @dataclass(frozen=True)
-class DdcConfig:
+class DiffDriveControllerConfig:
     """A DiffDriveController's parameters, validated, with the noetic defaults filled in.
 
     ``wheel_separation`` and ``wheel_radius`` are None when the YAML leaves them to the URDF; the caller
@@ -98,8 +99,8 @@ class DdcConfig:
         return self.left_wheels + self.right_wheels
 
 
-def ddc_config(params, name):
-    """Build a ``DdcConfig`` from the controller's parameter dict.
+def diff_drive_controller_config(params, name):
+    """Build a ``DiffDriveControllerConfig`` from the controller's parameter dict.
 
     Args:
         params: the controller namespace as rospy returns it, e.g. ``rospy.get_param('/mobile_base_controller')``:
@@ -107,7 +108,7 @@ def ddc_config(params, name):
         name: the controller namespace (``/mobile_base_controller``), used to name parameters in errors.
 
     Returns:
-        DdcConfig.
+        DiffDriveControllerConfig.
 
     Raises:
         ConfigError: naming the full parameter (``/mobile_base_controller/left_wheel``) whose value is
@@ -198,7 +199,7 @@ def ddc_config(params, name):
     values["linear"] = _axis_limits(ns, params, "linear", "x", unknown)
     values["angular"] = _axis_limits(ns, params, "angular", "z", unknown)
 
-    return DdcConfig(name=ns, left_wheels=left, right_wheels=right, unknown_keys=tuple(unknown),
+    return DiffDriveControllerConfig(name=ns, left_wheels=left, right_wheels=right, unknown_keys=tuple(unknown),
                      unsupported=tuple(unsupported), warnings=tuple(warnings), **values)
 
 

@@ -3,7 +3,8 @@
 Robots built for Gazebo + gazebo_ros_control load a DiffDriveController from their YAML; to run them
 unchanged the simulator must move the wheels and integrate odometry the way the controller does. This module
 holds that logic with time passed in as float seconds: ``DiffDriveControllerCore`` runs one control cycle per
-``update`` on a ``DdcConfig`` that :func:`diffbot_sim.control.diff_drive_config.ddc_config` checked.
+``update`` on a ``DiffDriveControllerConfig`` that
+:func:`diffbot_sim.control.diff_drive_config.diff_drive_controller_config` checked.
 Publishing odom, TF and ``cmd_vel_out`` and reading the URDF for missing geometry belong to the caller.
 """
 import math
@@ -14,7 +15,7 @@ from diffbot_sim.control.odometry import EncoderOdometry
 from diffbot_sim.errors import ConfigError
 
 
-class DdcStep(NamedTuple):
+class DiffDriveControllerStep(NamedTuple):
     """What one ``DiffDriveControllerCore.update`` asks of the caller.
 
     Attributes:
@@ -38,7 +39,7 @@ class DiffDriveControllerCore:
     cycle and ``set_command`` whenever a ``cmd_vel`` message arrives.
 
     Args:
-        config: a ``DdcConfig``.
+        config: a ``DiffDriveControllerConfig``.
         wheel_separation, wheel_radius: m, measured from the URDF by the caller; used only where the config
             leaves the parameter unset (an explicit parameter wins, as upstream).
 
@@ -135,7 +136,7 @@ class DiffDriveControllerCore:
             period: the control period [s]; default: time since the previous ``update`` (or ``starting``).
 
         Returns:
-            DdcStep.
+            DiffDriveControllerStep.
 
         Raises:
             RuntimeError: called before ``starting``. ValueError: not one position per configured joint
@@ -154,7 +155,7 @@ class DiffDriveControllerCore:
             left = _mean(left_positions, len(self.config.left_wheels), "left_positions")
             right = _mean(right_positions, len(self.config.right_wheels), "right_positions")
             if not (math.isfinite(left) and math.isfinite(right)):
-                return DdcStep(self._wheels[0], self._wheels[1], False, True)
+                return DiffDriveControllerStep(self._wheels[0], self._wheels[1], False, True)
             self.odometry.update(left, right, now)
 
         # Fixed rate on upstream's integer-nanosecond clock (float sums of 0.02 would jitter by a cycle);
@@ -174,7 +175,7 @@ class DiffDriveControllerCore:
 
         rim_left, rim_right = wheel_speeds(linear, angular, self.separation)
         self._wheels = (rim_left / self.left_radius, rim_right / self.right_radius)
-        return DdcStep(self._wheels[0], self._wheels[1], publish, False)
+        return DiffDriveControllerStep(self._wheels[0], self._wheels[1], publish, False)
 
     # -- state ----------------------------------------------------------------------------------------
 

@@ -24,7 +24,7 @@ def non_finite_field(values):
     return None
 
 
-class DiffDriveController:
+class GazeboDiffDriveCore:
     """Turns (v, w) commands into left/right wheel joint velocity targets [rad/s], on the plugin's schedule.
 
     Args:

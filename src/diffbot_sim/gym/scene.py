@@ -8,7 +8,7 @@ What bullet_sim does, this does through the same code (so a policy sees what it 
   parsed, meshes prepared) and placed by ``physics.robot_loading.place_robot`` (raised onto the world at its
   spawn point, set down calmly by ``World.load_robot``), as ``simulator/robots.py`` does.
 * The drive: the model's ``libgazebo_ros_diff_drive.so`` tags (or ``left_joints``... given as parameters, as
-  bullet_sim's ``~left_joints``) read by ``config.drive_config``; before each physics step the plugin's own
+  bullet_sim's ``~left_joints``) read by ``config.gazebo_diff_drive_config``; before each physics step the plugin's own
   step runs (``control.gazebo_diff_drive``, which ``plugins/diff_drive.py`` wraps with ROS): a new command
   reaches the wheel motors at once, otherwise the wheels are updated at the plugin's ``<update_rate>`` from
   their measured speeds, with its acceleration and wheel-speed limits, and braked when a command outlives
@@ -28,7 +28,7 @@ import os
 import numpy as np
 
 from diffbot_sim import config as cfgmod
-from diffbot_sim.control.gazebo_diff_drive import DiffDriveController, DriveWheels
+from diffbot_sim.control.gazebo_diff_drive import DriveWheels, GazeboDiffDriveCore
 from diffbot_sim.description import meshes
 from diffbot_sim.description.model_files import package_path
 from diffbot_sim.description.prepared_model import prepare_model, read_model_file
@@ -77,7 +77,7 @@ def resolve_model(name):
     raise ModelError("no such model file (searched the working directory and the diffbot_sim package)", name)
 
 
-class Drive:
+class SceneDrive:
     """The robot's gazebo_ros_diff_drive: the plugin's own step (``control.gazebo_diff_drive``, as
     ``plugins/diff_drive.py`` runs it under ROS) on the robot's wheels, commanded by the environment's actions
     instead of ``cmd_vel``.
@@ -89,7 +89,7 @@ class Drive:
 
     def __init__(self, robot, model, drive, sim):
         max_wheel_velocity = cfgmod.max_wheel_velocity(sim, model, drive)
-        self.core = DiffDriveController(drive.wheel_separation, drive.wheel_radius, max_wheel_velocity,
+        self.core = GazeboDiffDriveCore(drive.wheel_separation, drive.wheel_radius, max_wheel_velocity,
                                         drive.max_wheel_acceleration, sim.cmd_vel_timeout, drive.update_rate,
                                         sim.time_step)
         self.wheels = DriveWheels(robot, robot.indices(drive.left_joints), robot.indices(drive.right_joints),
@@ -114,7 +114,7 @@ class Drive:
         self.core.start(0.0)
 
 
-class Laser:
+class SceneLaser:
     """The robot's ray sensor as ``beams`` ranges [m] (misses read ``range_max``, too close ``range_min``)."""
 
     def __init__(self, robot, model, sensor, beams, mode, noise):
@@ -189,7 +189,7 @@ class Scene:
         cfg, world = self.cfg, self.world
         self.prepared = prepare_model(*read_model_file(resolve_model(cfg.model), cfg.model_args))
         model, found, notes = self.prepared.model, self.prepared.plugins, list(self.prepared.notes)
-        drive = cfgmod.drive_config(model, found.diff_drive, dict(cfg.drive), notes)
+        drive = cfgmod.gazebo_diff_drive_config(model, found.diff_drive, dict(cfg.drive), notes)
         if drive is None:
             raise ConfigError("GoalEnv drive", cfg.drive, "a model with a libgazebo_ros_diff_drive.so plugin, or "
                               "left_joints/right_joints naming its wheels")
@@ -210,8 +210,8 @@ class Scene:
             robot = self._load_robot(float(near[0]), float(near[1]), yaw)
         self.robot = robot
         sim = cfgmod.SimConfig(time_step=cfg.time_step, cmd_vel_timeout=cfg.cmd_vel_timeout)  # bullet_sim's defaults
-        self.drive = Drive(robot, model, drive, sim)
-        self.laser = Laser(robot, model, sensor, cfg.beams, cfg.scan_mode, cfg.laser_noise)
+        self.drive = SceneDrive(robot, model, drive, sim)
+        self.laser = SceneLaser(robot, model, sensor, cfg.beams, cfg.scan_mode, cfg.laser_noise)
         self.warnings += self.laser.warnings
         self.drive.reset()
         settle(world, robot)

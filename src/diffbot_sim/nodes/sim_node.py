@@ -14,7 +14,7 @@ Topics: each plugin's (its module docstring; resolved names are written to ``~cm
     ~debug/cmd_applied (geometry_msgs/TwistStamped): when ~debug_cmd_applied, the wall time a diff-drive
         command reached the motors (for latency measurement).
 Services: ~pause_physics, ~unpause_physics, ~reset_simulation (std_srvs/Empty).
-Parameters: see diffbot_sim.config.SimConfig and DriveConfig (README table).
+Parameters: see diffbot_sim.config.SimConfig and GazeboDiffDriveConfig (README table).
 """
 import os
 

@@ -186,7 +186,7 @@ class Plugin:
         """Publishers the loop writes to (their connections are tuned and batched by the simulator)."""
         return []
 
-    def next_due(self):
+    def next_control(self):
         """Sim time at which ``before_step`` has work (control); inf: only when a command arrives."""
         return math.inf
 

@@ -1,9 +1,10 @@
 """``libgazebo_ros_diff_drive.so`` (ROS 1 and ROS 2 tags) and, with other tags and defaults,
 ``libgazebo_ros_skid_steer_drive.so`` (see :mod:`diffbot_sim.plugins.skid_steer`).
 
-Tags, defaults and validation: :class:`diffbot_sim.config.DriveConfig` (one place). What it does each step
-(commands, schedule, timeout, limits, wheel speeds): :class:`diffbot_sim.control.gazebo_diff_drive.DiffDriveController`,
-the one engine the Gymnasium scene drives too; this module adds the ROS side and the odometry.
+Tags, defaults and validation: :class:`diffbot_sim.config.GazeboDiffDriveConfig` (one place). What it does
+each step (commands, schedule, timeout, limits, wheel speeds):
+:class:`diffbot_sim.control.gazebo_diff_drive.GazeboDiffDriveCore`, the one engine the Gymnasium scene drives
+too; this module adds the ROS side and the odometry.
 
 Topics (relative to the plugin's namespace): ``cmd_vel`` in (Twist: linear.x, angular.z), ``odom`` out,
 ``/tf`` odometry frame -> base frame when publish_odom_tf; ``~debug/cmd_applied`` when asked.
@@ -15,38 +16,38 @@ from geometry_msgs.msg import Twist, TwistStamped
 from nav_msgs.msg import Odometry
 
 from diffbot_sim import config as cfgmod
-from diffbot_sim.control.gazebo_diff_drive import DiffDriveController, DriveWheels
+from diffbot_sim.control.gazebo_diff_drive import DriveWheels, GazeboDiffDriveCore
 from diffbot_sim.control.odometry import EncoderOdometry
 from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import DRIVE_TWIST, Plugin, join, next_due, twist_callback
 from diffbot_sim.transforms import quaternion_from_yaw
 
 
-class DiffDrive(Plugin):
+class GazeboDiffDrive(Plugin):
     """One differential (or skid-steer) drive: cmd_vel -> wheel velocity motors; odometry out."""
 
     filename = "libgazebo_ros_diff_drive.so"
 
     def __init__(self, ctx, drive):
-        """``drive``: a validated DriveConfig (frames already prefixed and namespace placed)."""
+        """``drive``: a validated GazeboDiffDriveConfig (frames already prefixed and namespace placed)."""
         self.ctx = ctx
         self.drive = drive
         cfg, robot = ctx.cfg, ctx.robot
         self.max_wheel_velocity = cfgmod.max_wheel_velocity(cfg, ctx.model, drive)
-        self.controller = DiffDriveController(drive.wheel_separation, drive.wheel_radius, self.max_wheel_velocity,
-                                              drive.max_wheel_acceleration, cfg.cmd_vel_timeout, drive.update_rate,
-                                              cfg.time_step, ctx.sim.wake.set)
+        self.core = GazeboDiffDriveCore(drive.wheel_separation, drive.wheel_radius, self.max_wheel_velocity,
+                                        drive.max_wheel_acceleration, cfg.cmd_vel_timeout, drive.update_rate,
+                                        cfg.time_step, ctx.sim.wake.set)
         self.left_idx = robot.indices(drive.left_joints)
         self.right_idx = robot.indices(drive.right_joints)
         self.wheels = DriveWheels(robot, self.left_idx, self.right_idx, cfgmod.wheel_efforts(ctx.model, drive))
-        self.update_period = self.controller.update_period
+        self.update_period = self.core.update_period
         self.next_odom = 0.0
         self.encoder = EncoderOdometry(drive.wheel_radius, drive.wheel_separation)
         ns = drive.namespace
         # Validated here, on rospy's thread: a good command followed by a NaN one keeps the good one, as
         # diff_drive_controller does; the loop takes the newest at once in real time, at the next step in fast mode.
         self.cmd_sub = ctx.subscriber(join(ns, drive.command_topic), Twist,
-                                      twist_callback(ctx, self, self.controller.inbox, DRIVE_TWIST), queue_size=1)
+                                      twist_callback(ctx, self, self.core.inbox, DRIVE_TWIST), queue_size=1)
         self.odom_pub = ctx.publisher(join(ns, drive.odometry_topic), Odometry) if drive.publish_odom else None
         self.odom_builder = ros_msgs.OdometryBuilder(drive.odometry_frame, drive.robot_base_frame,
                                                      drive.covariance_x, drive.covariance_y, drive.covariance_yaw)
@@ -61,14 +62,14 @@ class DiffDrive(Plugin):
     def publishers(self):
         return [p for p in (self.odom_pub, self.debug_pub) if p is not None]
 
-    def next_due(self):
-        return self.controller.next_update
+    def next_control(self):
+        return self.core.next_update
 
     def next_publish(self):
         return self.next_odom
 
     def before_step(self, now):
-        applied = self.controller.before_step(now, self.wheels)
+        applied = self.core.before_step(now, self.wheels)
         if applied is not None and self.debug_pub is not None:
             self.debug_pub.publish(ros_msgs.twist_stamped(rospy.Time.from_sec(time.time()), *applied))
 
@@ -93,13 +94,13 @@ class DiffDrive(Plugin):
             transforms.append(self.tf_builder.build(stamp, position, orientation))
 
     def start(self, now):
-        self.controller.start(now)
+        self.core.start(now)
         self.next_odom = now
         positions, _, _ = self.ctx.robot.joint_states([self.left_idx[0], self.right_idx[0]])
         self.encoder.reset(positions[0], positions[1], now)
 
     def reset(self, now):
-        self.controller.reset()
+        self.core.reset()
         self.wheels.brake()
 
     def summary(self):
@@ -114,7 +115,7 @@ class DiffDrive(Plugin):
 
 def create(ctx, block, params):
     """The model's diff drive (``block`` may be None when ``~left_joints`` describes one), or None."""
-    drive = cfgmod.drive_config(ctx.model, block, params, ctx.warnings)
+    drive = cfgmod.gazebo_diff_drive_config(ctx.model, block, params, ctx.warnings)
     if drive is None:
         return None
     where = block.path if block is not None else "private parameters"
@@ -125,4 +126,4 @@ def create(ctx, block, params):
     else:  # a spawned robot: the tf_prefix its namespace's searchParam found (Noetic's gazebo_ros_utils)
         drive.odometry_frame = ctx.frame(drive.odometry_frame)
         drive.robot_base_frame = ctx.frame(drive.robot_base_frame)
-    return DiffDrive(ctx, drive)
+    return GazeboDiffDrive(ctx, drive)

@@ -77,7 +77,7 @@ class ForceBasedMove(Plugin):
     def publishers(self):
         return [self.pub]
 
-    def next_due(self):
+    def next_control(self):
         return self.ctx.sim.sim_time  # the wrench is added every step, as upstream does each world update
 
     def next_publish(self):

@@ -25,7 +25,7 @@ class GraspFix(Plugin):
         self.next_decision = 0.0
         ctx.warnings.extend(cfg.notes)
 
-    def next_due(self):
+    def next_control(self):
         return self.ctx.sim.sim_time
 
     def start(self, now):

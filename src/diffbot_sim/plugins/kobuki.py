@@ -96,7 +96,7 @@ class Kobuki(Plugin):
     def publishers(self):
         return [self.odom_pub, self.js_pub, self.imu_pub]
 
-    def next_due(self):
+    def next_control(self):
         if self.cmd_time is not None and self.wheel_cmd != (0.0, 0.0):
             return self.cmd_time + self.timeout
         return math.inf

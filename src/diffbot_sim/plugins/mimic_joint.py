@@ -45,7 +45,7 @@ class MimicJoint(Plugin):
         if not self.motor:
             robot.free_joints([self.mimic])
 
-    def next_due(self):
+    def next_control(self):
         return self.ctx.sim.sim_time
 
     def before_step(self, now):
@@ -78,7 +78,7 @@ class UrdfMimic(Plugin):
         self.names = [j.name for j in joints]
         self.couplings = [(robot.joint_index[j.mimic.joint], robot.joint_index[j.name], j.mimic) for j in joints]
 
-    def next_due(self):
+    def next_control(self):
         return self.ctx.sim.sim_time
 
     def before_step(self, now):

@@ -72,7 +72,7 @@ class PlanarMove(Plugin):
     def publishers(self):
         return [self.pub]
 
-    def next_due(self):
+    def next_control(self):
         return self.ctx.sim.sim_time  # the body velocity is set every step, as Gazebo does
 
     def before_step(self, now):

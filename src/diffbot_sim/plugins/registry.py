@@ -105,7 +105,7 @@ def build(ctx, found, params):
     if mimics is not None:
         plugins.append(mimics)
     if ctx.cfg.publish_ground_truth:
-        base = next((p.drive.robot_base_frame for p in plugins if isinstance(p, diff_drive.DiffDrive)),
+        base = next((p.drive.robot_base_frame for p in plugins if isinstance(p, diff_drive.GazeboDiffDrive)),
                     ctx.frame(ctx.model.root))
         plugins.append(GroundTruth(ctx, base))
     return plugins

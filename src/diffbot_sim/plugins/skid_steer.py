@@ -6,14 +6,14 @@ with covariances ``covariance_x/y/yaw`` (1e-4, 1e-4, 0.01); no acceleration limi
 """
 from diffbot_sim import config as cfgmod
 from diffbot_sim.description.urdf_model import tag_value
-from diffbot_sim.plugins.diff_drive import DiffDrive
+from diffbot_sim.plugins.diff_drive import GazeboDiffDrive
 
 #: Tags the ROS 1 plugin has (or had) that change nothing here.
 IGNORED = {"alwaysOn", "rosDebugLevel", "legacyMode", "publishWheelTF", "publishWheelJointState",
            "wheelAcceleration"}
 
 
-class SkidSteerDrive(DiffDrive):
+class SkidSteerDrive(GazeboDiffDrive):
     filename = "libgazebo_ros_skid_steer_drive.so"
 
 

@@ -59,9 +59,9 @@ class RobotRuntime:
         """Sim time of this robot's next publication."""
         return min((p.next_publish() for p in self.plugins), default=math.inf)
 
-    def next_due(self):
+    def next_work(self):
         """Sim time of the next thing this robot must do (control or publishing)."""
-        return min([p.next_due() for p in self.plugins] + [self.next_publish()], default=math.inf)
+        return min([p.next_control() for p in self.plugins] + [self.next_publish()], default=math.inf)
 
     def before_step(self, now):
         for plugin in self.plugins:
@@ -294,7 +294,7 @@ class Simulator:
                 if self.sim_time + dt > target + 1e-9:
                     # Sleep until the next thing due, or until a command wakes us. Publishing and control,
                     # not stepping, set the wake rate, so CPU stays low.
-                    due = min([self.next_clock] + [r.next_due() for r in self.robots])
+                    due = min([self.next_clock] + [r.next_work() for r in self.robots])
                     # Wake at the step that reaches ``due`` (steps land on multiples of dt), not at ``due``
                     # itself: waking between steps would only find nothing to do and sleep again.
                     step_at = math.ceil(due / dt - 1e-6) * dt

@@ -1,11 +1,13 @@
-"""diff_drive_config.ddc_config: a DiffDriveController's parameters read as ros_controllers (noetic) reads them:
-its defaults, its precedence, and one ConfigError naming the full parameter for a value it cannot use.
+"""diff_drive_config.diff_drive_controller_config: a DiffDriveController's parameters read as ros_controllers
+(noetic) reads them: its defaults, its precedence, and one ConfigError naming the full parameter for a value it
+cannot use.
 """
 import math
 
 import pytest
 
-from diffbot_sim.control.diff_drive_config import CONTROLLER_TYPE, DdcConfig, ddc_config
+from diffbot_sim.control.diff_drive_config import (CONTROLLER_TYPE, DiffDriveControllerConfig,
+                                                   diff_drive_controller_config)
 from diffbot_sim.errors import ConfigError
 
 NS = "/diffbot_controller"
@@ -28,8 +30,8 @@ def params(**overrides):
 
 
 def test_config_defaults_are_noetic():
-    config = ddc_config({"left_wheel": "l", "right_wheel": "r"}, "/mobile_base_controller")
-    assert isinstance(config, DdcConfig)
+    config = diff_drive_controller_config({"left_wheel": "l", "right_wheel": "r"}, "/mobile_base_controller")
+    assert isinstance(config, DiffDriveControllerConfig)
     assert config.name == "/mobile_base_controller"
     assert (config.left_wheels, config.right_wheels) == (("l",), ("r",))
     assert config.wheel_separation is None and config.wheel_radius is None
@@ -69,7 +71,7 @@ def test_config_from_a_real_robot_yaml():
                           "has_acceleration_limits": True, "max_acceleration": 6}},
         "k_l": 0.1, "k_r": 0.1,
     }
-    config = ddc_config(yaml, "/husky/mobile_base_controller/")
+    config = diff_drive_controller_config(yaml, "/husky/mobile_base_controller/")
     assert config.name == "/husky/mobile_base_controller"
     assert config.joints == ("front_left_wheel", "rear_left_wheel", "front_right_wheel", "rear_right_wheel")
     assert config.publish_rate == 50.0 and isinstance(config.publish_rate, float)
@@ -91,19 +93,20 @@ def test_bad_wheel_names_name_the_parameter(value):
     if value is not None:
         yaml["left_wheel"] = value
     with pytest.raises(ConfigError, match="/mobile_base_controller/left_wheel"):
-        ddc_config(yaml, "/mobile_base_controller")
+        diff_drive_controller_config(yaml, "/mobile_base_controller")
 
 
 def test_wheel_counts_must_match():
     with pytest.raises(ConfigError, match="/mobile_base_controller/right_wheel.*as many joints"):
-        ddc_config({"left_wheel": ["a", "b"], "right_wheel": "c"}, "/mobile_base_controller")
+        diff_drive_controller_config({"left_wheel": ["a", "b"], "right_wheel": "c"}, "/mobile_base_controller")
 
 
 def test_wheel_radius_multiplier_overrides_per_side():
-    config = ddc_config(params(wheel_radius_multiplier=1.2, left_wheel_radius_multiplier=0.9), NS)
+    config = diff_drive_controller_config(params(wheel_radius_multiplier=1.2, left_wheel_radius_multiplier=0.9), NS)
     assert config.left_wheel_radius_multiplier == config.right_wheel_radius_multiplier == 1.2
     assert any("left_wheel_radius_multiplier" in w and "ignored" in w for w in config.warnings)
-    config = ddc_config(params(left_wheel_radius_multiplier=0.9, right_wheel_radius_multiplier=1.1), NS)
+    config = diff_drive_controller_config(params(left_wheel_radius_multiplier=0.9,
+                                                 right_wheel_radius_multiplier=1.1), NS)
     assert (config.left_wheel_radius_multiplier, config.right_wheel_radius_multiplier) == (0.9, 1.1)
     assert config.warnings == ()
 
@@ -111,7 +114,7 @@ def test_wheel_radius_multiplier_overrides_per_side():
 def test_missing_covariances_are_zeros_with_a_warning():
     yaml = params()
     del yaml["pose_covariance_diagonal"], yaml["twist_covariance_diagonal"]
-    config = ddc_config(yaml, NS)
+    config = diff_drive_controller_config(yaml, NS)
     assert config.pose_covariance_diagonal == config.twist_covariance_diagonal == (0.0,) * 6
     assert len(config.warnings) == 2
     assert f"{NS}/pose_covariance_diagonal" in config.warnings[0]
@@ -121,7 +124,7 @@ def test_missing_covariances_are_zeros_with_a_warning():
                                             ([0.1] * 5 + [math.nan], "[5]")])
 def test_bad_covariance_names_the_parameter(value, culprit):
     with pytest.raises(ConfigError) as info:
-        ddc_config(params(twist_covariance_diagonal=value), NS)
+        diff_drive_controller_config(params(twist_covariance_diagonal=value), NS)
     assert info.value.name == f"{NS}/twist_covariance_diagonal{culprit}"
 
 
@@ -129,13 +132,13 @@ def test_unknown_keys_collected_at_every_level():
     yaml = params(k_l=0.1, preserve_turning_radius=True,
                   linear={"x": {"max_velocity": 1.0, "max_vel": 2.0}, "y": {"max_velocity": 1.0}},
                   angular={"z": {}})
-    config = ddc_config(yaml, NS)
+    config = diff_drive_controller_config(yaml, NS)
     assert set(config.unknown_keys) == {f"{NS}/k_l", f"{NS}/preserve_turning_radius", f"{NS}/linear/y",
                                         f"{NS}/linear/x/max_vel"}
 
 
 def test_leading_slash_frames_stripped_with_warning():
-    config = ddc_config(params(base_frame_id="/base_footprint", odom_frame_id="/odom"), NS)
+    config = diff_drive_controller_config(params(base_frame_id="/base_footprint", odom_frame_id="/odom"), NS)
     assert (config.base_frame_id, config.odom_frame_id) == ("base_footprint", "odom")
     assert len(config.warnings) == 2 and "leading slash" in config.warnings[0]
 
@@ -143,7 +146,7 @@ def test_leading_slash_frames_stripped_with_warning():
 @pytest.mark.parametrize("key, value", [("base_frame_id", ""), ("odom_frame_id", "/"), ("base_frame_id", 3)])
 def test_bad_frames(key, value):
     with pytest.raises(ConfigError, match=f"{NS}/{key}"):
-        ddc_config(params(**{key: value}), NS)
+        diff_drive_controller_config(params(**{key: value}), NS)
 
 
 @pytest.mark.parametrize("key, value", [
@@ -157,7 +160,7 @@ def test_bad_frames(key, value):
 ])
 def test_bad_values_name_the_parameter(key, value):
     with pytest.raises(ConfigError) as info:
-        ddc_config(params(**{key: value}), NS)
+        diff_drive_controller_config(params(**{key: value}), NS)
     assert info.value.name == f"{NS}/{key}"
 
 
@@ -170,17 +173,17 @@ def test_bad_values_name_the_parameter(key, value):
 ])
 def test_bad_limits_name_the_parameter(limits, culprit):
     with pytest.raises(ConfigError) as info:
-        ddc_config(params(linear=limits), NS)
+        diff_drive_controller_config(params(linear=limits), NS)
     assert info.value.name == f"{NS}/{culprit}"
 
 
 def test_disabled_limits_are_not_cross_checked():
-    config = ddc_config(params(linear={"x": {"max_acceleration": 1.0, "min_acceleration": 2.0}}), NS)
+    config = diff_drive_controller_config(params(linear={"x": {"max_acceleration": 1.0, "min_acceleration": 2.0}}), NS)
     assert config.linear.min_acceleration == 2.0
 
 
 def test_ints_and_integral_window_accepted():
-    config = ddc_config(params(cmd_vel_timeout=1, wheel_separation=1, wheel_radius=1,
+    config = diff_drive_controller_config(params(cmd_vel_timeout=1, wheel_separation=1, wheel_radius=1,
                                velocity_rolling_window_size=4.0, publish_rate=100,
                                angular={"z": {"has_jerk_limits": True, "max_jerk": 10}}), NS)
     assert config.cmd_vel_timeout == 1.0 and config.publish_rate == 100.0
@@ -190,6 +193,6 @@ def test_ints_and_integral_window_accepted():
 
 
 def test_wheel_joint_controller_state_is_unsupported():
-    config = ddc_config(params(publish_wheel_joint_controller_state=True), NS)
+    config = diff_drive_controller_config(params(publish_wheel_joint_controller_state=True), NS)
     assert config.unsupported == (f"{NS}/publish_wheel_joint_controller_state",)
     assert len(config.warnings) == 1

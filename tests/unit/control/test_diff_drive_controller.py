@@ -9,8 +9,8 @@ import math
 
 import pytest
 
-from diffbot_sim.control.diff_drive_config import ddc_config
-from diffbot_sim.control.diff_drive_controller import DdcStep, DiffDriveControllerCore
+from diffbot_sim.control.diff_drive_config import diff_drive_controller_config
+from diffbot_sim.control.diff_drive_controller import DiffDriveControllerStep, DiffDriveControllerCore
 from diffbot_sim.errors import ConfigError
 
 NS = "/diffbot_controller"
@@ -71,7 +71,7 @@ class FakeDiffbot:
     """ros_controllers' test/diffbot.h plus the controller manager loop of test/diffbot.cpp, minus ROS."""
 
     def __init__(self, config_params, true_radius=RADIUS):
-        self.config = ddc_config(config_params, NS)
+        self.config = diff_drive_controller_config(config_params, NS)
         self.core = DiffDriveControllerCore(self.config, wheel_separation=SEPARATION, wheel_radius=RADIUS)
         self.true_radius = true_radius
         n = len(self.config.left_wheels)
@@ -97,7 +97,7 @@ class FakeDiffbot:
             self.pos = [math.nan] * (2 * n)
             self.vel = [math.nan] * (2 * n)
         step = self.core.update(self.time, self.pos[:n], self.pos[n:])
-        assert isinstance(step, DdcStep)
+        assert isinstance(step, DiffDriveControllerStep)
         self.cmd = [step.left] * n + [step.right] * n
         if step.publish_odom:
             x, y, yaw = self.core.pose
@@ -153,7 +153,7 @@ def test_turn(variant):
 
 
 def test_wheel_commands_use_multiplied_geometry():
-    config = ddc_config(params(wheel_separation_multiplier=2.3, left_wheel_radius_multiplier=1.4,
+    config = diff_drive_controller_config(params(wheel_separation_multiplier=2.3, left_wheel_radius_multiplier=1.4,
                                right_wheel_radius_multiplier=0.7), NS)
     core = DiffDriveControllerCore(config, wheel_separation=SEPARATION, wheel_radius=RADIUS)
     core.starting(0.0)
@@ -361,7 +361,7 @@ def test_multiple_publishers_allowed_by_default():
 # -- lifecycle and publish schedule -----------------------------------------------------------------------
 
 def test_commands_refused_unless_running():
-    core = DiffDriveControllerCore(ddc_config(params(), NS), SEPARATION, RADIUS)
+    core = DiffDriveControllerCore(diff_drive_controller_config(params(), NS), SEPARATION, RADIUS)
     assert "not running" in core.set_command(0.1, 0.0, 0.0)
     with pytest.raises(RuntimeError):
         core.update(0.0, [0.0], [0.0])
@@ -425,7 +425,7 @@ def test_open_loop_ignores_wheel_positions():
 # -- geometry: the parameters or the URDF ---------------------------------------------------------------
 
 def test_geometry_parameter_wins_over_urdf():
-    config = ddc_config(params(wheel_separation=0.5), NS)
+    config = diff_drive_controller_config(params(wheel_separation=0.5), NS)
     core = DiffDriveControllerCore(config, wheel_separation=0.9, wheel_radius=0.1)
     assert (core.separation, core.left_radius, core.right_radius) == (0.5, 0.1, 0.1)
 
@@ -435,5 +435,6 @@ def test_geometry_parameter_wins_over_urdf():
                                                          (0.5, 0.0, "wheel_radius")])
 def test_geometry_required_from_parameter_or_urdf(separation, radius, culprit):
     with pytest.raises(ConfigError) as info:
-        DiffDriveControllerCore(ddc_config(params(), NS), wheel_separation=separation, wheel_radius=radius)
+        DiffDriveControllerCore(diff_drive_controller_config(params(), NS), wheel_separation=separation,
+                                wheel_radius=radius)
     assert info.value.name == f"{NS}/{culprit}"

@@ -1,18 +1,18 @@
-"""control.gazebo_diff_drive: DiffDriveController — refusal of non-finite commands, clamping, timeout brake,
+"""control.gazebo_diff_drive: GazeboDiffDriveCore — refusal of non-finite commands, clamping, timeout brake,
 acceleration ramp from the measured velocity, curvature kept under saturation; the plugin's step (a new
 command at once, updates on the schedule, a stale command braked at its step) and its wheels."""
 import math
 
 import pytest
 
-from diffbot_sim.control.gazebo_diff_drive import TWIST_FIELDS, DiffDriveController, DriveWheels, non_finite_field
+from diffbot_sim.control.gazebo_diff_drive import TWIST_FIELDS, GazeboDiffDriveCore, DriveWheels, non_finite_field
 from diffbot_sim.control.kinematics import body_velocity
 
 SEP, RAD, VMAX = 0.2, 0.032, 40.0  # the seed: max_linear = 1.28 m/s, max angular = 12.8 rad/s
 
 
 def make(**kwargs):
-    return DiffDriveController(SEP, RAD, VMAX, **kwargs)
+    return GazeboDiffDriveCore(SEP, RAD, VMAX, **kwargs)
 
 
 def body(targets):

@@ -36,7 +36,7 @@ class Loaded:
         for trans in self.model.transmissions:
             self.model.joint(trans.joint, f"/robot/transmission[@name='{trans.name}']")
         self.drive_notes = []
-        self.drive = config.drive_config(self.model, self.found.diff_drive, {}, self.drive_notes)
+        self.drive = config.gazebo_diff_drive_config(self.model, self.found.diff_drive, {}, self.drive_notes)
         ctx = RobotContext(None, config.SimConfig(), config.RobotSpec(), self.model, None, {}, None, "~")
         self.drive.odometry_frame = ctx.clean_frame(self.drive.odometry_frame, self.found.diff_drive.path)
         self.drive.robot_base_frame = ctx.clean_frame(self.drive.robot_base_frame, self.found.diff_drive.path)

@@ -7,7 +7,7 @@ import pybullet
 import pytest
 
 from diffbot_sim import physics
-from diffbot_sim.control.gazebo_diff_drive import DiffDriveController
+from diffbot_sim.control.gazebo_diff_drive import GazeboDiffDriveCore
 from diffbot_sim.control.odometry import EncoderOdometry
 from diffbot_sim.description import lumping
 from diffbot_sim.description.urdf_model import parse_urdf
@@ -208,7 +208,7 @@ def test_controller_and_encoder_odometry_track_physics(seed):
     """Closed loop as the node runs it: controller -> motors -> wheel angles -> odometry vs physics pose."""
     world, robot = seed
     wheels = robot.indices(WHEELS)
-    ctrl = DiffDriveController(S, R, 40.0, max_wheel_acceleration=1.8)
+    ctrl = GazeboDiffDriveCore(S, R, 40.0, max_wheel_acceleration=1.8)
     odom = EncoderOdometry(R, S)
     ctrl.set_command(0.2, 0.8, 0.0)
     t = 0.0

@@ -128,7 +128,7 @@ class Plugin:
     def publishers(self):
         return self.pubs
 
-    def next_due(self):
+    def next_control(self):
         return self.due
 
     def next_publish(self):
@@ -160,7 +160,7 @@ class Context:
 
 def test_a_robot_without_plugins_is_never_due():
     runtime = RobotRuntime("r", Context(), [])
-    assert runtime.next_due() == math.inf and runtime.next_publish() == math.inf and runtime.publishers() == []
+    assert runtime.next_work() == math.inf and runtime.next_publish() == math.inf and runtime.publishers() == []
 
 
 def test_the_robot_is_due_at_its_earliest_plugin():
@@ -170,9 +170,9 @@ def test_the_robot_is_due_at_its_earliest_plugin():
     runtime = RobotRuntime("r", Context(), [drive, laser])
     assert runtime.publishers() == ["odom", "tf", "scan"]
     assert runtime.next_publish() == 0.02
-    assert runtime.next_due() == 0.01
+    assert runtime.next_work() == 0.01
     drive.due = 0.5
-    assert runtime.next_due() == 0.02  # a publication is due first
+    assert runtime.next_work() == 0.02  # a publication is due first
 
 
 def test_every_plugin_is_called_in_order_and_close_goes_to_the_context():

@@ -45,7 +45,7 @@ class RosControl(Plugin):
     def publishers(self):
         return self.manager.publishers()
 
-    def next_due(self):
+    def next_control(self):
         return self.ctx.sim.sim_time if self.hw.joints else math.inf
 
     def next_publish(self):

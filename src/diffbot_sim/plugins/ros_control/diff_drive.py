@@ -21,7 +21,7 @@ class DiffDriveController(Controller):
     def __init__(self, ctx, hw, name, params):
         super().__init__(ctx, hw, name, params)
         model = ctx.model
-        cfg = ddc_cfg.ddc_config(params, name)
+        cfg = ddc_cfg.diff_drive_controller_config(params, name)
         for warning in cfg.warnings:
             ctx.warnings.append(warning)
         if cfg.unknown_keys:
