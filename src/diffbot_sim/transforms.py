@@ -1,5 +1,6 @@
 """Rotations and poses as plain numbers (pure; numpy only): URDF/SDF roll-pitch-yaw, (x, y, z, w)
-quaternions, their rotation matrices, planar yaw, and poses composed and inverted.
+quaternions, their rotation matrices, planar yaw, poses composed and inverted, and ignition-math's
+quaternion interpolation (slerp, squad) as Gazebo's animations use it.
 
 One place for the conventions every reader shares: fixed-axis roll, pitch, yaw (R = Rz(yaw) Ry(pitch)
 Rx(roll), as URDF and SDF define them, and as ``tf.transformations.quaternion_from_euler`` with its
@@ -102,6 +103,79 @@ def roll_pitch_from_quaternion(x, y, z, w):
     roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
     pitch = math.asin(max(-1.0, min(1.0, 2.0 * (w * y - z * x))))
     return roll, pitch
+
+
+# ------------------------------------------------------------------------------------------------ interpolation
+# ignition-math6's Quaternion operations that Gazebo's animations use (an actor's script), with its exact
+# formulas and thresholds, so that an interpolation lands where Gazebo's does, quirks included.
+
+#: ``ignition::math::equal``'s default tolerance: values this close count as equal.
+IGN_EQUAL = 1e-6
+
+
+def qinverse(q):
+    """``Quaternion::Inverse``: the conjugate over the squared norm (the identity for a zero quaternion)."""
+    norm2 = sum(c * c for c in q)
+    if abs(norm2) <= IGN_EQUAL:
+        return (0.0, 0.0, 0.0, 1.0)
+    return (-q[0] / norm2, -q[1] / norm2, -q[2] / norm2, q[3] / norm2)
+
+
+def qlog(q):
+    """``Quaternion::Log``: angle * axis when sin(angle) >= 1e-3, else the vector part as it is (w = 0)."""
+    x, y, z, w = q
+    if abs(w) < 1.0:
+        angle = math.acos(w)
+        sin = math.sin(angle)
+        if abs(sin) >= 1e-3:
+            c = angle / sin
+            return (c * x, c * y, c * z, 0.0)
+    return (x, y, z, 0.0)
+
+
+def qexp(q):
+    """``Quaternion::Exp``: (sin a * axis, cos a) for the vector part of length a."""
+    x, y, z, _ = q
+    angle = math.sqrt(x * x + y * y + z * z)
+    sin = math.sin(angle)
+    c = sin / angle if abs(sin) >= 1e-3 else 1.0
+    return (c * x, c * y, c * z, math.cos(angle))
+
+
+def _qscale(q, s):
+    return tuple(c * s for c in q)
+
+
+def _qadd(a, b):
+    return tuple(x + y for x, y in zip(a, b))
+
+
+def slerp(t, p, q, shortest_path=False):
+    """``Quaternion::Slerp``: spherical interpolation ``p`` -> ``q`` at ``t`` in 0..1; ``shortest_path`` flips
+    ``q`` when the two are more than half a turn apart; near-equal (|cos| >= 0.999) ends are lerped."""
+    cos = sum(a * b for a, b in zip(p, q))
+    if cos < 0.0 and shortest_path:
+        cos, q = -cos, _qscale(q, -1.0)
+    if abs(cos) < 1.0 - 1e-3:
+        sin = math.sqrt(1.0 - cos * cos)
+        angle = math.atan2(sin, cos)
+        return _qadd(_qscale(p, math.sin((1.0 - t) * angle) / sin), _qscale(q, math.sin(t * angle) / sin))
+    mix = _qadd(_qscale(p, 1.0 - t), _qscale(q, t))
+    norm = math.sqrt(sum(c * c for c in mix))
+    return (0.0, 0.0, 0.0, 1.0) if abs(norm) <= IGN_EQUAL else _qscale(mix, 1.0 / norm)
+
+
+def squad(t, p, a, b, q, shortest_path=False):
+    """``Quaternion::Squad``: Shoemake's spherical quadrangle through ``p``, ``q`` with inner points ``a``,
+    ``b``."""
+    return slerp(2.0 * t * (1.0 - t), slerp(t, p, q, shortest_path), slerp(t, a, b))
+
+
+def shoemake_tangent(p, later, earlier):
+    """``RotationSpline``'s inner point at ``p`` between its neighbours ``earlier`` and ``later``:
+    ``p exp(-(log(p^-1 later) + log(p^-1 earlier)) / 4)``."""
+    inv = qinverse(p)
+    return qmul(p, qexp(_qscale(_qadd(qlog(qmul(inv, later)), qlog(qmul(inv, earlier))), -0.25)))
 
 
 # ------------------------------------------------------------------------------------------------ planar

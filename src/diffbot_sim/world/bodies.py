@@ -80,4 +80,4 @@ class WorldDescription:
     not_simulated: List[str] = field(default_factory=list)
     warnings: List[str] = field(default_factory=list)
     has_ground: bool = False  # a ground plane is among the bodies (else the simulator adds its own)
-    actors: List[object] = field(default_factory=list)  # world.actor_script.ActorDescription, in file order
+    actors: List[object] = field(default_factory=list)  # world.actor_sdf.ActorDescription, in file order

@@ -32,7 +32,7 @@ import os
 
 from diffbot_sim.errors import ModelError
 from diffbot_sim.transforms import compose, inverse
-from diffbot_sim.world.actor_script import read_actor
+from diffbot_sim.world.actor_sdf import read_actor
 from diffbot_sim.world.bodies import IDENTITY, Body, WorldDescription
 from diffbot_sim.world.model_paths import env_model_paths
 from diffbot_sim.world.sdf_elements import ElementReader, sdf_bool, text_of
@@ -205,7 +205,7 @@ class _Reader:
             self.world.gravity = self.values.floats(gravity_el.text, 3, src, f"{wpath}/gravity", "<gravity>")
 
     def actor(self, el, src, path):
-        """A Gazebo ``<actor>``: read as Gazebo 11 reads it (:mod:`diffbot_sim.world.actor_script`); its
+        """A Gazebo ``<actor>``: read as Gazebo 11 reads it (:mod:`diffbot_sim.world.actor_sdf`); its
         numbers leniently, each oddity one warning."""
         notes = []
         actor = read_actor(el, f"{src.path}: {path}", notes)

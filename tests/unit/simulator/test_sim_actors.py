@@ -9,7 +9,7 @@ import pytest
 
 from diffbot_sim.physics import World
 from diffbot_sim.simulator.actors import Actors
-from diffbot_sim.world.actor_script import read_actor
+from diffbot_sim.world.actor_sdf import read_actor
 from diffbot_sim.world.actor_walk import PERSON_SIZE, WALK_ROOT_HEIGHT
 from diffbot_sim.world.bodies import Body, Shape, WorldDescription
 

@@ -1,4 +1,5 @@
-"""world.actor_script and world.actor_walk: Gazebo-classic 11 <actor> reading, script playback, ActorPlugin.
+"""world.actor_sdf, actor_splines, actor_script and actor_walk: Gazebo-classic 11 <actor> reading, script
+playback, ActorPlugin.
 
 Fixtures are written inline after gazebo-classic's worlds/actor.world, animated_box.world (the actor
 tutorial's square), animation_tension.world and cafe.world. Expected positions are hand-computed from the
@@ -12,7 +13,9 @@ import xml.etree.ElementTree as ET
 import pytest
 
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.world.actor_script import ActorScript, pose6_to_pose, read_actor, slerp
+from diffbot_sim.transforms import slerp
+from diffbot_sim.world.actor_script import ActorScript
+from diffbot_sim.world.actor_sdf import pose6_to_pose, read_actor
 from diffbot_sim.world.actor_walk import (FLOOR_X, FLOOR_Y, PERSON_SIZE, WALK_ROOT_HEIGHT, ActorWalker,
                                           person_box, read_walker_config, upright_pose)
 
