@@ -267,6 +267,13 @@ class Robot:
         moved = tuple(com[i] + offset[i] for i in range(3))
         pybullet.resetBasePositionAndOrientation(self.body, moved, orientation, physicsClientId=self.client)
 
+    def set_joint_velocities(self, indices, velocities):
+        """Gazebo's Joint::SetVelocity: each joint's velocity [rad/s or m/s] set now, its position kept, no motor
+        holding it during the step (free the joints first): friction then acts on a free joint, as in Gazebo."""
+        states = pybullet.getJointStates(self.body, indices, physicsClientId=self.client)
+        for index, state, velocity in zip(indices, states, velocities):
+            pybullet.resetJointState(self.body, index, state[0], velocity, physicsClientId=self.client)
+
     def set_joint_positions(self, indices, positions):
         """Joint angles [rad] set at rest (set_model_configuration)."""
         for index, position in zip(indices, positions):

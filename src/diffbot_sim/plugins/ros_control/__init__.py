@@ -6,7 +6,8 @@ controllers (:mod:`.forward_command`), ``*/JointTrajectoryController`` (:mod:`.j
 ``*/GripperActionController`` (:mod:`.gripper_action`).
 
 Plugin tags: ``robotNamespace`` (default: the spawner's ``/``; a ``~robots`` robot's own namespace replaces
-it), ``robotSimType`` (only DefaultRobotHWSim is simulated; another is one warning), ``controlPeriod`` (s; see
+it), ``robotSimType`` (DefaultRobotHWSim, and SteerBotHardwareGazebo in :mod:`.steer_bot_hardware`; another is
+one warning and the default), ``controlPeriod`` (s; see
 :mod:`.manager` for the default), ``eStopTopic`` (std_msgs/Bool), ``robotParam`` and ``legacyModeNS`` (accepted).
 """
 import math
@@ -17,9 +18,12 @@ from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.plugins.base import Plugin, join
 from diffbot_sim.plugins.ros_control.hardware import RobotHWSim
 from diffbot_sim.plugins.ros_control.manager import KNOWN_TYPES, ControllerManager, ControllerManagerServices
+from diffbot_sim.plugins.ros_control.steer_bot_hardware import SteerBotHWSim
 from diffbot_sim.values import tag_number
 
 DEFAULT_SIM_TYPE = "gazebo_ros_control/DefaultRobotHWSim"
+#: robotSimType -> the hardware simulated for it (built as ``cls(ctx, ns, warnings)``); others: the default
+HW_SIMS = {DEFAULT_SIM_TYPE: RobotHWSim, "steer_bot_hardware_gazebo/SteerBotHardwareGazebo": SteerBotHWSim}
 
 
 class RosControl(Plugin):
@@ -27,7 +31,7 @@ class RosControl(Plugin):
 
     def __init__(self, ctx, path, ns, period, estop_topic, sim_type):
         self.ctx, self.path, self.ns, self.sim_type = ctx, path, ns, sim_type
-        self.hw = RobotHWSim(ctx, ns, ctx.warnings)
+        self.hw = HW_SIMS.get(sim_type, RobotHWSim)(ctx, ns, ctx.warnings)
         self.manager = ControllerManager(ctx, self.hw, ns, period)
         self._estop = None  # the latest e-stop message, applied on the loop
         self.estop_sub = (ctx.subscriber(join(ns, estop_topic), Bool, self._on_estop, queue_size=1)
@@ -90,7 +94,7 @@ def create(ctx, element, path, params):
     if not ns.startswith("/"):
         ns = "/" + ns
     sim_type = tags.get("robotSimType") or DEFAULT_SIM_TYPE
-    if sim_type != DEFAULT_SIM_TYPE:
+    if sim_type not in HW_SIMS:
         ctx.warnings.append(f"{path}: robotSimType '{sim_type}' is not simulated; using {DEFAULT_SIM_TYPE}")
     period = None
     if tags.get("controlPeriod"):
