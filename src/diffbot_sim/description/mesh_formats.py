@@ -10,6 +10,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
+from diffbot_sim.description import xml_documents
 from diffbot_sim.errors import ModelError
 
 #: Binary STL: an 80-byte header, a little-endian uint32 triangle count, then 50-byte records.
@@ -189,7 +190,7 @@ class _Collada:
     def __init__(self, path):
         self.path = path
         try:
-            root = ET.fromstring(_read_bytes(path))
+            root = xml_documents.parse(_read_bytes(path))  # a blank line before <?xml is fine, as in Gazebo
         except ET.ParseError as err:
             raise ModelError(f"malformed XML ({err})", path) from None
         for element in root.iter():

@@ -6,7 +6,7 @@ lazily so the rest of the package stays importable without them.
 """
 import os
 
-from diffbot_sim.description import xacro_compat
+from diffbot_sim.description import xacro_compat, xml_documents
 from diffbot_sim.errors import ModelError
 
 
@@ -36,7 +36,7 @@ def load_file(path, args=None):
     if not path.endswith(".xacro"):
         try:
             with open(path, encoding="utf-8") as handle:
-                return handle.read()
+                return xml_documents.document_start(handle.read())  # blank lines before <?xml, as TinyXML
         except (OSError, UnicodeDecodeError) as err:
             raise ModelError(f"cannot read ({err})", path) from None
     xacro = xacro_compat.apply()  # lazy import of xacro: only xacro files need it; idempotent

@@ -11,7 +11,7 @@ model lacks is an error naming the transmission, as gazebo_ros_control's loader 
 import os
 from typing import List, NamedTuple
 
-from diffbot_sim.description import meshes
+from diffbot_sim.description import meshes, xml_documents
 from diffbot_sim.description.model_files import load_file, package_path, parse_args
 from diffbot_sim.description.plugin_tags import NATIVE, Plugins, read_plugins
 from diffbot_sim.description.urdf_model import RobotModel, parse_urdf
@@ -62,6 +62,7 @@ def prepare_model(text, source, known=NATIVE, known_sensors=(), cache_dir=None, 
         ModelError: the URDF is not a robot, a mesh cache that cannot be written, a transmission naming a
             joint the model lacks.
     """
+    text = xml_documents.document_start(text)  # a robot_description with a blank line before <?xml
     model = parse_urdf(text, source)
     model_dir = os.path.dirname(source) if os.path.isfile(source) else os.getcwd()
     text, notes = meshes.prepare_meshes(text, source, model_dir, cache_dir or meshes.default_cache_dir(),

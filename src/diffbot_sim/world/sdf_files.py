@@ -12,6 +12,7 @@ error naming every directory searched.
 import os
 import xml.etree.ElementTree as ET
 
+from diffbot_sim.description import xml_documents
 from diffbot_sim.errors import ModelError
 
 #: The SDF versions this reader knows; others are read as the nearest one (with a warning).
@@ -43,13 +44,21 @@ class SdfFile:
         self.version = version
 
 
-def parse_xml(path, text=None):
-    """ElementTree root of ``path`` (or of ``text``, labelled ``path``); a ModelError names file and line."""
+def parse_xml(path, text=None, warn=None):
+    """ElementTree root of ``path`` (or of ``text``, labelled ``path``); a ModelError names file and line.
+
+    Read as sdformat's TinyXML reads it (:mod:`diffbot_sim.description.xml_documents`): whitespace or a
+    byte-order mark before ``<?xml`` is skipped, and with ``warn`` anything after the root element is
+    ignored with one warning (Gazebo ignores it silently).
+    """
+    def after_root(line):
+        warn(f"{path}: line {line}: text after the root element ignored, as Gazebo's parser ignores it")
+
     try:
         if text is None:
             with open(path, "rb") as handle:
                 text = handle.read()
-        return ET.fromstring(text)
+        return xml_documents.parse(text, after_root if warn else None)
     except ET.ParseError as err:
         line, column = err.position
         detail = str(err).split(":")[0]
@@ -82,7 +91,7 @@ class SdfFiles:
     def load(self, path, text=None, label=None):
         """Parse an SDF file -> (root, _File). Version outside 1.4-1.9: warned, read as the nearest."""
         label = label or path
-        root = parse_xml(label, text) if text is not None else parse_xml(path)
+        root = parse_xml(label, text, self.warn) if text is not None else parse_xml(path, warn=self.warn)
         if root.tag != "sdf":
             raise ModelError(f"root element is <{root.tag}>, expected <sdf>", label, f"/{root.tag}")
         raw = root.get("version")
@@ -105,7 +114,7 @@ class SdfFiles:
                 raise ModelError(f"model directory {directory} has no model.config", src.path, path)
             self.warn(f"{manifest}: manifest.xml is deprecated in favour of model.config; read anyway")
             config = manifest
-        root = parse_xml(config)
+        root = parse_xml(config, warn=self.warn)
         entries = [(e.get("version"), (e.text or "").strip()) for e in root.iter("sdf") if (e.text or "").strip()]
         if not entries:
             raise ModelError("names no <sdf> file", config, "/model/sdf")
