@@ -13,7 +13,9 @@ Topics: each plugin's (its module docstring; resolved names are written to ``~cm
     ~ground_truth (nav_msgs/Odometry): when ~publish_ground_truth.
     ~debug/cmd_applied (geometry_msgs/TwistStamped): when ~debug_cmd_applied, the wall time a diff-drive
         command reached the motors (for latency measurement).
-Services: ~pause_physics, ~unpause_physics, ~reset_simulation (std_srvs/Empty).
+Services: ~pause_physics, ~unpause_physics, ~reset_simulation (std_srvs/Empty); the /gazebo world API under
+``~gazebo_namespace`` (default /gazebo; a node named ``gazebo``, as empty_world.launch names it, serves it
+under its own name, as gazebo_ros does: ``/<group ns>/gazebo/...``).
 Parameters: see diffbot_sim.config.SimConfig and GazeboDiffDriveConfig (README table).
 """
 import os
@@ -56,6 +58,10 @@ def _main():
     owns_clock = _own_the_clock()
     try:
         params = rospy.get_param("~", {})
+        if "gazebo_namespace" not in params and rospy.get_name().rsplit("/", 1)[-1] == "gazebo":
+            # gazebo_ros advertises its world API under its node's name ("~"): empty_world.launch inside
+            # <group ns="my_robot"> serves /my_robot/gazebo/spawn_urdf_model; /clock stays global
+            params["gazebo_namespace"] = rospy.get_name()
         cfg = cfgmod.sim_config(params)
         if cfg.gui and not os.environ.get("DISPLAY"):
             rospy.logwarn("~gui is true but there is no display (DISPLAY unset): running headless (DIRECT)")
