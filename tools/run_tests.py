@@ -204,6 +204,8 @@ NAV_FIXTURES = os.path.join(ROOT, "tests", "data", "nav_way")
 MANIPULATOR_FIXTURES = os.path.join(ROOT, "tests", "data", "manipulator_way")
 #: A Gazebo user's multi-robot packages (a TurtleBot3-class robot, a house of meshes) the multi_way suites launch.
 MULTI_FIXTURES = os.path.join(ROOT, "tests", "data", "multi_way")
+#: A Gazebo user's car-like robots (a bicycle model with Gazebo in its namespace, a SteerBotHardwareGazebo base).
+CAR_FIXTURES = os.path.join(ROOT, "tests", "data", "car_way")
 NAV_NEEDS = ("move_base", "amcl", "map_server", "gmapping", "dwa_local_planner")
 
 
@@ -321,6 +323,7 @@ def main():
     os.makedirs(RESULTS, exist_ok=True)
     add_package_path(MANIPULATOR_FIXTURES)
     add_package_path(MULTI_FIXTURES)
+    add_package_path(CAR_FIXTURES)
     total_p = total_f = total_s = 0
     failures = []
     if args.only is None:
