@@ -1,5 +1,6 @@
 """Shared helpers of the arm suites: FollowJointTrajectory goals, joint states, and the body judged by the
 physics' ground truth (/gazebo/get_link_state) against joint_states + the URDF (check.arm_check)."""
+import collections
 import math
 import threading
 
@@ -14,31 +15,97 @@ from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 from diffbot_sim.check.arm_check import pose_errors
 from diffbot_sim.description.urdf_model import parse_urdf
 from simtest import action_done, wait_for
+from traittest import sim_now
 
 
 class JointStates:
-    """The latest position of every joint on /joint_states (several publishers merge, as in TF)."""
+    """Every joint's positions on /joint_states, each value with the stamp (sim time) of the message that carried
+    it (several publishers merge, as in TF), and the recent messages themselves: a sample of "now" is a message
+    stamped now or later, and "at rest" is positions held within a band over a window of their stamps.
 
-    def __init__(self, topic="/joint_states"):
+    Why stamps and not counts or receipt: a test node starved of CPU (a busy machine) works through its queue of
+    joint_states late; the newest message it holds can be half a second of sim time old, and "two more callbacks
+    ran" still hands out positions from before the command. ``now`` gives the simulator's own sim time
+    (traittest.sim_now by default: /gazebo/get_world_properties, not this node's lagging /clock); ``topic`` None
+    subscribes nothing (messages are then fed to ``_keep`` by hand, as a check of this class does)."""
+
+    #: messages kept for ``settled`` (50 Hz: 100 s of sim time)
+    KEPT = 5000
+
+    def __init__(self, topic="/joint_states", now=None):
         self.lock = threading.Lock()
-        self.positions, self.velocities, self.count = {}, {}, 0
-        self.sub = rospy.Subscriber(topic, JointState, self._keep, queue_size=50)
+        self.positions, self.velocities, self.stamps, self.count = {}, {}, {}, 0
+        self.history = collections.deque(maxlen=self.KEPT)  # (stamp, {name: position}) per message
+        self.now = now or sim_now
+        # every message kept, however late this node reads them: a dropped message would be a gap in a window
+        self.sub = rospy.Subscriber(topic, JointState, self._keep, queue_size=1000) if topic else None
 
     def _keep(self, msg):
+        stamp = msg.header.stamp.to_sec()
         with self.lock:
+            if self.history and stamp < self.history[-1][0]:  # sim time went back (reset_simulation)
+                self.history.clear()
             self.positions.update(zip(msg.name, msg.position))
             self.velocities.update(zip(msg.name, msg.velocity))
+            self.stamps.update((name, stamp) for name in msg.name)
+            self.history.append((stamp, dict(zip(msg.name, msg.position))))
             self.count += 1
 
     def get(self, names=None):
         with self.lock:
             return dict(self.positions) if names is None else [self.positions.get(n) for n in names]
 
-    def fresh(self, timeout=10.0):
-        """Positions received after now."""
-        start = self.count
-        wait_for(lambda: self.count > start + 1, timeout, "fresh joint_states")
-        return self.get()
+    def fresh(self, names=None, since=None, timeout=10.0):
+        """Positions (a dict, or a list in the order of ``names``) from messages stamped at or after ``since``
+        (sim time; default the simulator's sim time when this is called): what the joints were at or after that
+        moment, the message after the command. Fails after ``timeout`` wall seconds."""
+        since = self.now() if since is None else since
+
+        def stamped_after():
+            with self.lock:
+                wanted = list(self.stamps) if names is None else list(names)
+                if wanted and all(self.stamps.get(n, -math.inf) >= since for n in wanted):
+                    return dict(self.positions) if names is None else [self.positions[n] for n in names]
+            return None
+        return wait_for(stamped_after, timeout, f"joint_states stamped at or after {since:.3f} s of sim time")
+
+    def settled(self, names=None, band=0.001, window=0.3, timeout=20.0, since=None):
+        """Positions (as ``fresh``) once every joint of ``names`` (default: all) has stayed within ``band`` (rad
+        or m, max - min) over the last ``window`` s of sim time, judged by the stamps of messages stamped at or
+        after ``since`` (default: the sim time when this is called), and the window covered (a message at or
+        before its start). One message with low velocities is an instant, which an oscillation's turnaround also
+        passes; this is the arm holding still. Fails after ``timeout`` wall seconds, naming the widest joint."""
+        since = self.now() if since is None else since
+        worst = ["no joint_states stamped after the call yet"]
+
+        def still():
+            with self.lock:
+                messages = [(t, p) for t, p in self.history if t >= since]
+                latest = dict(self.positions)
+            if not messages:
+                return None
+            last = messages[-1][0]
+            if last - messages[0][0] < window - 1e-9:
+                worst[0] = f"{last - messages[0][0]:.3f} s of sim time seen so far"
+                return None
+            recent = [p for t, p in messages if t >= last - window - 1e-9]
+            wanted = names if names is not None else sorted({n for p in recent for n in p})
+            spread = {}
+            for name in wanted:
+                values = [p[name] for p in recent if name in p]
+                if not values:
+                    worst[0] = f"no {name} in the window"
+                    return None
+                spread[name] = max(values) - min(values)
+            widest = max(spread, key=spread.get)
+            if spread[widest] > band:
+                worst[0] = f"{widest} moved {spread[widest]:.5f} over the last {window} s"
+                return None
+            return latest if names is None else [latest[n] for n in names]
+        try:
+            return wait_for(still, timeout, f"the joints settled (within {band} over {window} s of sim time)")
+        except AssertionError as failure:
+            raise AssertionError(f"{failure}: {worst[0]}") from None
 
 
 def trajectory(joints, *points, stamp=None):
@@ -92,15 +159,11 @@ class Arm:
         """The links Gazebo keeps (the root and every child of a moving joint)."""
         return [self.model.root] + [j.child for j in self.model.joints.values() if j.type != "fixed"]
 
-    def at_rest(self, speed=0.02):
-        with self.states.lock:
-            return self.states.count > 0 and all(abs(v) < speed for v in self.states.velocities.values())
-
     def body_errors(self, settle_timeout=20.0):
         """{link: PoseError} of every kept link: ground truth against joint_states + the URDF, taken once the
-        joints are at rest and with the physics paused while the links are read (one instant for all)."""
-        wait_for(self.at_rest, settle_timeout, "the joints at rest (joint_states velocities < 0.02)")
-        positions = self.states.fresh()
+        joints have settled (``JointStates.settled``: within 1 mrad over 0.3 s of sim time) and with the physics
+        paused while the links are read (one instant for all)."""
+        positions = self.states.settled(timeout=settle_timeout)
         rospy.ServiceProxy("/gazebo/pause_physics", Empty)()
         try:
             measured = {link: self.world_pose(link) for link in self.links()}

@@ -14,13 +14,13 @@ judged by the body (ground truth: /gazebo/get_link_state). Robots: arm_commands.
 import os
 import subprocess
 import sys
-import time
 import unittest
 
 import rospy
 import rostest
 import yaml
 from gazebo_msgs.srv import ApplyJointEffort, GetJointProperties, JointRequest, SetModelConfiguration
+from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64, Float64MultiArray
 from std_srvs.srv import Empty
@@ -29,7 +29,7 @@ from trajectory_msgs.msg import JointTrajectory
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from armtest import trajectory  # noqa: E402
 from simtest import Latest, wait_for  # noqa: E402
-from traittest import Manager, Rosout, Truth, sim_now, sim_sleep  # noqa: E402
+from traittest import Manager, Rosout, Truth, settled, sim_now, sim_sleep  # noqa: E402
 
 from diffbot_sim.check.arm_check import pose_errors  # noqa: E402
 
@@ -54,13 +54,19 @@ class ArmCommands(unittest.TestCase):
         with open(os.path.join(ROBOTS, "arm_group_controllers.yaml")) as text:
             cls.group_params = yaml.safe_load(text)
         cls.managers = {ns: Manager(ns) for ns in ARMS}
+        clocks = []  # /clock goes on while paused (as Gazebo's): its messages count the simulator's loop going round
+        clock_sub = rospy.Subscriber("/clock", Clock, lambda msg: clocks.append(msg.clock.to_sec()), queue_size=100)
         paused_at = sim_now()
         for ns, group in ARMS.items():  # while paused: every arm held where it stands before time runs
             manager = cls.managers[ns]
             for name in ("joint_state_controller", group):
                 assert manager.load(name, cls.group_params[name]), f"/{ns}: {name} did not load"
             assert manager.switch(start=["joint_state_controller", group]), f"/{ns}: not started"
-        time.sleep(0.5)
+        # a look at a paused world: five /clock messages after the switches (the paused loop sends one every 0.1 s
+        # of its own time), however slowly this node runs; unpaused, fast mode would race ahead meanwhile
+        seen = len(clocks)
+        wait_for(lambda: len(clocks) >= seen + 5, 30, "five /clock messages while paused")
+        clock_sub.unregister()
         cls.was_paused = (paused_at, sim_now())
         cls.states = {ns: Latest(f"/{ns}/joint_states", JointState) for ns in ARMS}
         cls.spawn = subprocess.run(
@@ -89,18 +95,10 @@ class ArmCommands(unittest.TestCase):
                  f"/{ns} joints at {target} (at {self.arm(ns)})")
 
     def settled_arm(self, ns, seconds=0.3, tolerance=0.001, timeout=30):
-        """The arm's joints once they have stopped moving (two reads ``seconds`` of sim time apart agree within
-        ``tolerance`` rad or m): a PID-held arm goes on settling after it first reaches its target."""
-        last = [self.arm(ns)]
-
-        def still():
-            sim_sleep(seconds)
-            now = self.arm(ns)
-            done = all(abs(a - b) < tolerance for a, b in zip(now, last[0]))
-            last[0] = now
-            return done
-        wait_for(still, timeout, f"/{ns}'s arm at rest")
-        return last[0]
+        """The arm's joints (ground truth) once they have stopped moving: every reading within ``tolerance`` rad
+        or m over ``seconds`` of sim time (traittest.settled): a PID-held arm goes on settling after it first
+        reaches its target."""
+        return settled(lambda: self.arm(ns), tolerance, window=seconds, timeout=timeout, what=f"/{ns}'s arm")
 
     def assert_still(self, ns, before, what, seconds=0.5, tolerance=0.005):
         sim_sleep(seconds)
@@ -126,9 +124,11 @@ class ArmCommands(unittest.TestCase):
         self.assertLess(turned[1].angle, angle, f"/{ns}: link {turned[0]} is turned {turned[1].angle:.4f} rad off")
 
     def joint_states(self, ns):
-        msg = wait_for(self.states[ns].get, 10, f"/{ns}/joint_states")
-        sim_sleep(0.1)
-        msg = self.states[ns].get()
+        """{joint: position} from a /<ns>/joint_states message stamped at or after the simulator's sim time now
+        (the newest this node holds may be older on a busy machine)."""
+        since = sim_now()
+        msg = wait_for(lambda: (m := self.states[ns].get()) is not None and m.header.stamp.to_sec() >= since and m,
+                       10, f"/{ns}/joint_states stamped at or after {since:.3f}")
         return dict(zip(msg.name, msg.position))
 
     def rate(self, joint):
@@ -243,7 +243,7 @@ class ArmCommands(unittest.TestCase):
         target = [0.5, 0.4, 0.3]
         group.publish(Float64MultiArray(data=target))
         self.wait_arm(ns, target)
-        sim_sleep(0.5)
+        self.settled_arm(ns)
         self.body_agrees(ns, self.joint_states(ns))
         before, mark = self.settled_arm(ns), self.rosout.mark()
         group.publish(Float64MultiArray(data=[0.1, 0.1]))
@@ -311,7 +311,7 @@ class ArmCommands(unittest.TestCase):
         target = [0.3, 0.5, 0.4]
         group.publish(Float64MultiArray(data=target))
         self.wait_arm(ns, target)
-        sim_sleep(0.5)
+        self.settled_arm(ns)
         self.body_agrees(ns, self.joint_states(ns))
         before, mark = self.settled_arm(ns), self.rosout.mark()
         group.publish(Float64MultiArray(data=[0.0, 0.0, 0.0, 0.0]))
@@ -341,7 +341,6 @@ class ArmCommands(unittest.TestCase):
         command = self.publisher(f"/{ns}/arm_controller/command", JointTrajectory)
         command.publish(trajectory(JOINTS, (1.0, [0.2, 0.3, 0.4])))
         self.wait_arm(ns, [0.2, 0.3, 0.4])
-        sim_sleep(0.5)
         cases = [
             ("NaN", trajectory(JOINTS, (1.0, [0.1, float("nan"), 0.0]))),
             ("Inf", trajectory(JOINTS, (1.0, [0.1, 0.0, float("inf")]))),

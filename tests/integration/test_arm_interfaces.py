@@ -15,7 +15,7 @@ from control_msgs.msg import FollowJointTrajectoryResult as Result
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from armtest import Arm, close, trajectory  # noqa: E402
-from simtest import wait_for  # noqa: E402
+from traittest import sim_sleep  # noqa: E402
 
 JOINTS = ["joint_1", "joint_2", "joint_3"]
 TARGET = [0.8, 1.0, 0.6]  # joint_2 tilts the arm 1 rad, joint_3 bends it further: a long lever against gravity
@@ -32,12 +32,11 @@ class ArmInterfaces(unittest.TestCase):
         state, result = arm.run(trajectory(JOINTS, (1.0, [0.4, 0.5, 0.3]), (2.5, TARGET)))
         self.assertEqual((state, result.error_code), (GoalStatus.SUCCEEDED, Result.SUCCESSFUL),
                          f"{name}: {result.error_string}")
-        self.assertTrue(close(arm.states.fresh() and arm.states.get(JOINTS), TARGET, 0.03),
-                        f"{name}: joints at {arm.states.get(JOINTS)}, goal {TARGET}")
+        reached = arm.states.fresh(JOINTS)  # from a message stamped after the goal's result
+        self.assertTrue(close(reached, TARGET, 0.03), f"{name}: joints at {reached}, goal {TARGET}")
         arm.assert_body_agrees(self, distance=0.003, angle=0.01)
         tool = arm.world_pose("link_3")[0]
-        start = rospy.get_time()
-        wait_for(lambda: rospy.get_time() - start > 3.0, 60, "3 s of sim time")
+        sim_sleep(3.0, timeout=60)  # holds for 3 s of the simulator's sim time
         later = arm.world_pose("link_3")[0]
         self.assertLess(math.dist(tool, later), 0.005, f"{name}: the stretched arm sagged {math.dist(tool, later):.4f} m")
         return arm

@@ -37,7 +37,7 @@ from std_srvs.srv import Empty
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from simtest import Latest, action_done, wait_for  # noqa: E402
-from traittest import Manager, Truth, sim_sleep, spawn_box  # noqa: E402
+from traittest import Manager, Truth, settled, sim_now, sim_sleep, spawn_box  # noqa: E402
 
 from diffbot_sim.transforms import compose  # noqa: E402
 
@@ -52,22 +52,6 @@ CONTROLLERS = {"grip_effort": ["gripper_effort_controller"], "grip_position": ["
 GRIPPERS = {"grip_effort": "gripper_effort_controller", "grip_position": "gripper_position_controller"}
 BOX = (0.03, 0.04, 0.04)  # m: the box the vises close on (x, along the jaw travel, height)
 HELD, LET_GO = 0.05, 0.3  # m a pushed box travels at most when gripped, at least when the grip lets it slide
-
-
-def settle(read, tolerance, timeout=30.0, interval=0.3):
-    """Wait until ``read()`` (a list of numbers) changes by less than ``tolerance`` over ``interval`` s of sim
-    time; returns the last reading."""
-    last = read()
-
-    def still():
-        nonlocal last
-        sim_sleep(interval)
-        now = read()
-        done = all(abs(a - b) < tolerance for a, b in zip(now, last))
-        last = now
-        return done
-    wait_for(still, timeout, "the readings to come to rest")
-    return last
 
 
 class ArmTraits(unittest.TestCase):
@@ -121,7 +105,7 @@ class ArmTraits(unittest.TestCase):
         spawn_box(name, BOX, 0.1, compose(base, local)[0])
         # at rest before the jaws close on it (it drops the 1 mm and settles against the jaw): a box still
         # moving is squeezed tilted
-        settle(lambda: list(self.truth.object(name)[0]), 0.0001, interval=0.2)
+        settled(lambda: list(self.truth.object(name)[0]), 0.0001, window=0.2, what=f"the box {name}")
 
     def assert_clamped(self, ns, name, when):
         """The box, in the vise's base frame, lies between the jaws' faces (its 3 cm along x within the jaws'
@@ -153,7 +137,7 @@ class ArmTraits(unittest.TestCase):
             self.assertEqual(status, GoalStatus.SUCCEEDED, f"/{ns}: {result}")
             self.assertTrue(result.reached_goal and not result.stalled, f"/{ns}: {result}")
             self.assertAlmostEqual(result.position, 0.06, delta=0.002)
-            rest = settle(lambda: [self.jaw(ns)], 0.0005)[0]  # the goal is met on the way (goal_tolerance 2 mm)
+            rest = settled(lambda: [self.jaw(ns)], 0.0005)[0]  # the goal is met on the way (goal_tolerance 2 mm)
             self.assertAlmostEqual(rest, 0.06, delta=0.003, msg=f"/{ns}: the jaw came to rest off its goal")
 
     def test_gripper_2_stall_on_a_box_squeezing_with_the_effort_each_variant_uses(self):
@@ -198,7 +182,7 @@ class ArmTraits(unittest.TestCase):
     def test_gripper_3_max_effort_zero_does_not_move_the_effort_jaw(self):
         ns = "grip_effort"
         self.grip(ns, 0.03, 15.0)
-        before = settle(lambda: [self.jaw(ns)], 0.0005)[0]
+        before = settled(lambda: [self.jaw(ns)], 0.0005)[0]
         status, result = self.grip(ns, 0.07, 0.0)
         # limp, the jaw may drift a little on a base the pushes before left off level; driven, it would have
         # gone the 4 cm to its goal within the 0.5 s the stall takes
@@ -264,7 +248,7 @@ class ArmTraits(unittest.TestCase):
                 self.master_to(ns, master, pub)
             for ns, ((m_pid, o_pid), (m_kin, o_kin)) in followers.items():
                 names = ["master_joint", "follower_pid_joint", "follower_kinematic_joint"]
-                actual, pid, kinematic = settle(lambda: self.truth.joints(ns, names), 0.001)
+                actual, pid, kinematic = settled(lambda: self.truth.joints(ns, names), 0.001)
                 self.assertAlmostEqual(pid, m_pid * actual + o_pid, delta=0.01,
                                        msg=f"/{ns}: the PID mimic joint at {pid:.4f} for master {actual:.4f}")
                 # mimic_swapped's kinematic follower moves only for target changes of at least its sensitiveness
@@ -281,17 +265,17 @@ class ArmTraits(unittest.TestCase):
         names = ["master_joint", "follower_kinematic_joint"]
         pub = self.publisher(f"/{ns}/master_position_controller/command", Float64)
         self.master_to(ns, 0.5, pub)
-        master, follower = settle(lambda: self.truth.joints(ns, names), 0.0005)
+        master, follower = settled(lambda: self.truth.joints(ns, names), 0.0005)
         gap = (-master + 0.3) - follower
         self.assertLess(abs(gap), 0.05 + 0.002, f"the follower {gap:.4f} from its target")
         target = follower - math.copysign(0.03, gap or 1.0)
         self.master_to(ns, 0.3 - target, pub)  # the target moved by |gap| + 0.03 >= 0.03
-        still = settle(lambda: self.truth.joints(ns, names), 0.0005)[1]
+        still = settled(lambda: self.truth.joints(ns, names), 0.0005)[1]
         self.assertAlmostEqual(still, follower, delta=0.002,
                                msg=f"a target change of {abs(gap) + 0.03:.3f} rad that leaves it within sensitiveness "
                                    "0.05 moved the mimic joint")
         self.master_to(ns, 1.0, pub)
-        master, follower = settle(lambda: self.truth.joints(ns, names), 0.0005)
+        master, follower = settled(lambda: self.truth.joints(ns, names), 0.0005)
         self.assertAlmostEqual(follower, -master + 0.3, delta=0.05)
 
     def test_mimic_3_urdf_mimic_without_a_plugin(self):
@@ -299,7 +283,7 @@ class ArmTraits(unittest.TestCase):
         pub = self.publisher(f"/{ns}/master_position_controller/command", Float64)
         for master in (0.7, -0.4):
             self.master_to(ns, master, pub)
-            actual, follower = settle(lambda: self.truth.joints(ns, ["master_joint", "follower_joint"]), 0.001)
+            actual, follower = settled(lambda: self.truth.joints(ns, ["master_joint", "follower_joint"]), 0.001)
             self.assertAlmostEqual(follower, -1.0 * actual + 0.1, delta=0.005,
                                    msg=f"follower_joint at {follower:.4f} for master {actual:.4f}")
 
@@ -348,7 +332,7 @@ class ArmTraits(unittest.TestCase):
         median = sorted(rates)[len(rates) // 2]
         self.assertAlmostEqual(median, 0.4, delta=0.03, msg="pos_joint is not rate-limited at joint_limits/pos_joint/"
                                f"max_velocity 0.4 rad/s (URDF 0.5): {rates} rad/s")
-        end = settle(lambda: [self.truth.joint(ns, "pos_joint")], 0.001)[0]
+        end = settled(lambda: [self.truth.joint(ns, "pos_joint")], 0.001)[0]
         self.assertAlmostEqual(end, 1.0, delta=0.01, msg="pos_joint did not stop at its upper limit 1.0")
 
     def test_limits_2_velocity_clamped(self):
@@ -375,7 +359,7 @@ class ArmTraits(unittest.TestCase):
         self.assertTrue(resp.success, resp.status_message)
         try:
             pub.publish(Float64(5.0))
-            end = settle(lambda: [self.truth.joint(ns, "eff_joint")], 0.001)[0]
+            end = settled(lambda: [self.truth.joint(ns, "eff_joint")], 0.001)[0]
         finally:
             self.clear_joint("eff_joint")
             pub.publish(Float64(0.0))
@@ -387,7 +371,7 @@ class ArmTraits(unittest.TestCase):
         ns = "limits"
         pub = self.publisher(f"/{ns}/soft_pos_controller/command", Float64)
         pub.publish(Float64(1.0))
-        end = settle(lambda: [self.truth.joint(ns, "soft_pos_joint")], 0.001)[0]
+        end = settled(lambda: [self.truth.joint(ns, "soft_pos_joint")], 0.001)[0]
         self.assertAlmostEqual(end, 0.8, delta=0.02, msg=f"soft_pos_joint at {end:.3f}, soft limit 0.8")
 
     def test_limits_5_continuous_joint_unwrapped(self):
@@ -395,12 +379,12 @@ class ArmTraits(unittest.TestCase):
         states = Latest(f"/{ns}/joint_states", JointState)
         pub = self.publisher(f"/{ns}/wrap_controller/command", Float64)
         pub.publish(Float64(4.0))
-        end = settle(lambda: [self.truth.joint(ns, "wrap_joint")], 0.001)[0]
+        end = settled(lambda: [self.truth.joint(ns, "wrap_joint")], 0.001)[0]
         self.assertAlmostEqual(math.remainder(end - 4.0, 2 * math.pi), 0.0, delta=0.01,
                                msg=f"wrap_joint's link at {end:.3f} rad, not 4.0 - 2 pi")
-        msg = wait_for(states.get, 10, "joint_states")
-        sim_sleep(0.1)
-        msg = states.get()
+        since = sim_now()  # a message stamped after the link was read at rest, not the newest this node holds
+        msg = wait_for(lambda: (m := states.get()) is not None and m.header.stamp.to_sec() >= since and m, 10,
+                       f"/{ns}/joint_states stamped at or after {since:.3f}")
         self.assertAlmostEqual(dict(zip(msg.name, msg.position))["wrap_joint"], 4.0, delta=0.01,
                                msg="joint_states does not carry the unwrapped position")
 
@@ -417,18 +401,18 @@ class ArmTraits(unittest.TestCase):
         spawn_box("slippery_box", (0.04, 0.04, 0.04), 0.1, (x, y, 0.0705), mu=0.05)
         fingers.publish(Float64MultiArray(data=[-3.0, -3.0]))
         sim_sleep(1.0)  # gripped at 10 Hz: attached after more than 3 counts
-        start = self.truth.object("slippery_box")[0]
+        box = lambda: list(self.truth.object("slippery_box")[0])  # noqa: E731
+        start = settled(box, 0.0005, what="the gripped box")
         self.assertAlmostEqual(start[2], 0.07, delta=0.003, msg="the box is not on the base")
         lift.publish(Float64(0.0))
         wait_for(lambda: abs(self.truth.joint(ns, "lift_joint")) < 0.003, 30, "the palm raised")
-        sim_sleep(0.5)
-        carried = self.truth.object("slippery_box")[0]
+        carried = settled(box, 0.0005, what="the lifted box")  # at rest with the palm, not at one moment after it
         self.assertAlmostEqual(carried[2] - start[2], 0.235, delta=0.01,
                                msg=f"the box rose {carried[2] - start[2]:.3f} m with the palm's 0.235 m")
         self.assertLess(math.dist(carried[:2], start[:2]), 0.01, "the box swung away while attached")
         fingers.publish(Float64MultiArray(data=[3.0, 3.0]))
-        sim_sleep(1.5)
-        dropped = self.truth.object("slippery_box")[0]
+        sim_sleep(1.5)  # released and fallen within 1.5 s of sim time; then judged where it came to rest
+        dropped = settled(box, 0.0005, what="the released box")
         self.assertAlmostEqual(dropped[2], 0.07, delta=0.01, msg=f"the box was not released (at z {dropped[2]:.3f})")
         self.delete("slippery_box")
 

@@ -18,6 +18,7 @@ from geometry_msgs.msg import Twist
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from armtest import Arm, close, trajectory  # noqa: E402
 from simtest import wait_for  # noqa: E402
+from traittest import sim_sleep  # noqa: E402
 
 ARM = ["joint1", "joint2", "joint3", "joint4"]
 MODEL = "robot"  # spawn_model -model robot
@@ -39,18 +40,19 @@ class ManipulatorWay(unittest.TestCase):
         target = [0.5, -0.6, 0.4, 0.7]
         state, result = self.arm.run(trajectory(ARM, (2.0, target)))
         self.assertEqual((state, result.error_code), (GoalStatus.SUCCEEDED, Result.SUCCESSFUL), result.error_string)
-        self.assertTrue(close(self.arm.states.fresh() and self.arm.states.get(ARM), target, 0.1))
+        self.assertTrue(close(self.arm.states.fresh(ARM), target, 0.1))  # a message stamped after the result
         self.arm.assert_body_agrees(self, distance=0.003, angle=0.01)
         hand = self.arm.world_pose("link5")[0]
-        start = rospy.get_time()
-        wait_for(lambda: rospy.get_time() - start > 2.0, 60, "2 s of sim time")
+        sim_sleep(2.0, timeout=60)  # holds for 2 s of the simulator's sim time
         self.assertLess(math.dist(hand, self.arm.world_pose("link5")[0]), 0.003, "the arm did not hold still")
 
     def test_2_gripper_opens_and_the_mimic_finger_follows(self):
         for opening in (0.015, -0.005):
             state, result = self.gripper.run(trajectory(["gripper"], (1.0, [opening])))
             self.assertEqual(state, GoalStatus.SUCCEEDED, result.error_string)
-            positions = self.gripper.states.fresh()
+            # where the jaws came to rest (within 0.1 mm over 0.3 s of sim time), not one message after the result
+            positions = self.gripper.states.settled(["gripper", "gripper_sub"], band=0.0001)
+            positions = dict(zip(["gripper", "gripper_sub"], positions))
             self.assertAlmostEqual(positions["gripper"], opening, delta=0.003)
             self.assertAlmostEqual(positions["gripper_sub"], opening, delta=0.003, msg="gripper_sub does not mimic")
         self.gripper.assert_body_agrees(self, distance=0.003, angle=0.01)

@@ -164,6 +164,39 @@ def sim_sleep(seconds, timeout=60.0):
     wait_for(lambda: sim_now() >= start + seconds, timeout, f"{seconds} s of sim time")
 
 
+def settled(read, band, window=0.3, timeout=30.0, what="the readings"):
+    """The last of ``read()``'s readings (a list of numbers: ground truth, read through services) once every one
+    of them has stayed within ``band`` (max - min) over at least ``window`` s of the simulator's sim time; fails
+    after ``timeout`` wall seconds naming the widest. Read again and again, each reading bracketed by sim_now()
+    before and after it: the window counts from the first reading's latest possible moment to the last one's
+    earliest, so a starved test node that reads seldom still spans the window. Two readings ``window`` apart
+    that agree are not enough: an oscillation's two ends can."""
+    samples = []  # (sim time before the read, sim time after it, reading), oldest first
+    moved = ["never out of the band: the window of sim time not yet covered"]
+
+    def spread():
+        return [max(r[i] for _, _, r in samples) - min(r[i] for _, _, r in samples) for i in range(len(samples[0][2]))]
+
+    def still():
+        before = sim_now()
+        reading = list(read())
+        samples.append((before, sim_now(), reading))
+        widths = spread()
+        if max(widths, default=0.0) > band:
+            widest = max(range(len(widths)), key=widths.__getitem__)
+            moved[0] = f"the last move: reading {widest} by {widths[widest]:.5f} (now {reading})"
+        while len(samples) > 1 and max(spread(), default=0.0) > band:
+            del samples[0]  # the window starts after the last reading out of the band
+        while len(samples) > 2 and samples[-1][0] - samples[1][1] >= window:
+            del samples[0]  # the window is covered without the oldest
+        return reading if samples[-1][0] - samples[0][1] >= window else None
+
+    try:
+        return wait_for(still, timeout, f"{what} settled (within {band} over {window} s of sim time)")
+    except AssertionError as failure:
+        raise AssertionError(f"{failure}: {moved[0]}") from None
+
+
 def paused(action):
     """Run ``action`` with the physics paused (one instant for several ground-truth calls)."""
     _proxy("/gazebo/pause_physics", Empty)()
