@@ -28,7 +28,7 @@ CAMERA_ROBOT = os.path.join(ROOT, "tests", "data", "robots", "camera_robot.urdf"
 PLAIN_ROBOT = os.path.join(ROOT, "tests", "data", "robots", "fixed_caster.urdf")
 W, H, HFOV, NEAR, FAR = 640, 480, 1.047, 0.05, 20.0
 
-from diffbot_sim.waiting import wait_for  # noqa: E402  (src/ on the path first)
+from diffbot_sim.waiting import wait_for
 
 
 def robot_640(path):

@@ -33,7 +33,6 @@ import time
 from multiprocessing import shared_memory
 
 import numpy as np
-
 from bench_items import fleet
 from benchkit import bare
 from benchkit.common import STEP  # s: the fleet's step, as make bench

@@ -14,6 +14,7 @@ The two are measured in alternating rounds and the medians reported, so a busy m
 Prints one JSON line and a short table.
 """
 import argparse
+import importlib
 import json
 import os
 import statistics
@@ -74,7 +75,7 @@ def main():
 
     import gymnasium
 
-    import diffbot_sim.gym  # noqa: F401 (registers the ids)
+    importlib.import_module("diffbot_sim.gym")  # registers the environments' ids with gymnasium
 
     env = gymnasium.make(args.id, scan_mode=args.scan_mode)
     env.action_space.seed(0)

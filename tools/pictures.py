@@ -30,8 +30,8 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "src"))
 
-from diffbot_sim.view import xscreen  # noqa: E402
-from diffbot_sim.waiting import wait_for  # noqa: E402
+from diffbot_sim.view import xscreen
+from diffbot_sim.waiting import wait_for
 
 DOCS = os.path.join(ROOT, "docs")
 ROBOT = os.path.join(ROOT, "tests", "data", "robots", "view_robot.urdf")
@@ -237,7 +237,6 @@ def fleet_picture(path, side=10, spacing=1.0):
     PyBullet's TinyRenderer."""
     import numpy as np
     import pybullet
-
     from bench_items import fleet  # tools/bench_items: the fleet item's model
     from benchkit import bare
 

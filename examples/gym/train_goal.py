@@ -26,10 +26,12 @@ sys.path.insert(0, os.path.join(ROOT, "src"))
 
 def make_env(env_id, **kwargs):
     """One environment as the agent sees it: observations rescaled to [-1, 1] from the Box's bounds."""
+    import importlib
+
     import gymnasium
     import numpy as np
 
-    import diffbot_sim.gym  # noqa: F401 (registers the ids)
+    importlib.import_module("diffbot_sim.gym")  # registers the environments' ids with gymnasium
 
     env = gymnasium.make(env_id, **kwargs)
     low, high = env.observation_space.low, env.observation_space.high

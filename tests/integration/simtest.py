@@ -15,10 +15,13 @@ from sensor_msgs.msg import JointState
 from std_srvs.srv import Empty
 from tf2_msgs.msg import TFMessage
 
+from diffbot_sim import waiting
+
+# HEIGHT_TOLERANCE, MAX_TILT (m, rad): a driving body stays this close to its rest height, and tilts less than
+# this (drive_check's bounds)
+from diffbot_sim.check.drive_check import HEIGHT_TOLERANCE, MAX_TILT
+
 SIM = "/bullet_sim"
-#: m / rad: a driving body stays this close to its rest height, and tilts less than this (drive_check's bounds).
-from diffbot_sim.check.drive_check import HEIGHT_TOLERANCE, MAX_TILT  # noqa: E402
-from diffbot_sim import waiting  # noqa: E402
 
 
 def yaw_of(q):
@@ -250,7 +253,8 @@ def sim_now(gazebo="/gazebo"):
 
 
 def reset_robot(rec):
-    """Zero the command, reset the world (models to their start; sim time goes on), and wait until odom shows the robot back at rest."""
+    """Zero the command, reset the world (models to their start; sim time goes on), and wait until odom shows the
+    robot back at rest."""
     rec.send(0.0, 0.0)
     call(SIM + "/reset_world")  # time goes on (reset_simulation would send it back to 0)
     after = rec.sim_time() + 0.1  # the service returned: anything stamped later follows the reset

@@ -149,8 +149,8 @@ class DriveTest(unittest.TestCase):
     def test_clock_monotonic_and_stamps_sim_time(self):
         rec = self.rec
         rec.wait_sim(1.0)
-        # In fast mode a test node stalled for longer than ~send_timeout (CPU shared with another suite) may have its /clock
-        # connection dropped by the simulator's send timeout; rospy reconnects, so wait for the count.
+        # In fast mode a test node stalled for longer than ~send_timeout (CPU shared with another suite) may have its
+        # /clock connection dropped by the simulator's send timeout; rospy reconnects, so wait for the count.
         rec.wait(lambda: len(rec.snapshot(rec.clock)) > 50, 30.0, "more than 50 /clock messages")
         stamps = [m.clock.to_sec() for m in rec.snapshot(rec.clock)]
         self.assertTrue(all(b > a for a, b in zip(stamps, stamps[1:])), "/clock must strictly increase")

@@ -21,10 +21,17 @@ import rostest
 from gazebo_msgs.srv import GetModelState, GetWorldProperties
 from geometry_msgs.msg import Twist
 from sensor_msgs.msg import LaserScan
-from simtest import Latest, sim_now, yaw_of
-from simtest import wait_for as wait
-from test_multi_way import CENTRAL, HOUSING_RADIUS, MEAN_TOLERANCE, RAY_TOLERANCE, beam_angles, fresh, ray_hits, \
-    scan_origin
+from simtest import Latest, sim_now, wait_for as wait, yaw_of
+from test_multi_way import (
+    CENTRAL,
+    HOUSING_RADIUS,
+    MEAN_TOLERANCE,
+    RAY_TOLERANCE,
+    beam_angles,
+    fresh,
+    ray_hits,
+    scan_origin,
+)
 
 SIM = "/bullet_sim"
 CLEAR = 0.02  # m: a beam passing a housing closer than this may go either way, and is not judged as a miss

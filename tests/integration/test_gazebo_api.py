@@ -18,13 +18,11 @@ import unittest
 import rosgraph
 import rospy
 import rostest
-from gazebo_msgs import msg as gmsg
-from gazebo_msgs import srv as gsrv
+from gazebo_msgs import msg as gmsg, srv as gsrv
 from geometry_msgs.msg import Point, Pose, Quaternion, Twist, Vector3, Wrench
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
-from simtest import Latest, assert_upright, yaw_of
-from simtest import wait_for as wait
+from simtest import Latest, assert_upright, wait_for as wait, yaw_of
 from std_srvs.srv import Empty
 
 GZ = "/gazebo"

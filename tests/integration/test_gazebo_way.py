@@ -17,8 +17,7 @@ from gazebo_msgs.srv import GetModelState, GetWorldProperties
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState, LaserScan
-from simtest import Latest, assert_upright, yaw_of
-from simtest import wait_for as wait
+from simtest import Latest, assert_upright, wait_for as wait, yaw_of
 
 WALL_Y = 5.0
 DRIVE = 0.8  # m each robot drives forward (0.4 m/s for 2 s), judged on its body (/gazebo/get_model_state)

@@ -10,7 +10,6 @@ scans' stamps (every step 0.2 s of sim time after the last) and by the body (gro
 as one step of the command says), at well above real time.
 """
 import math
-import os
 import sys
 import time
 import unittest
@@ -23,10 +22,8 @@ from gazebo_msgs.srv import DeleteModel, SpawnModel
 from geometry_msgs.msg import Pose, Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
+from simtest import GOAL_MARKER_SDF, Latest, agent_work, wait_for
 from std_srvs.srv import Empty
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from simtest import GOAL_MARKER_SDF, Latest, agent_work, wait_for  # noqa: E402
 
 SCAN_PERIOD = 0.2  # s: laser_robot.urdf's 5 Hz laser
 STEPS = 30

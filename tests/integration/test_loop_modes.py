@@ -27,11 +27,9 @@ from gazebo_msgs.srv import SetPhysicsProperties
 from geometry_msgs.msg import Twist, Vector3
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
+from simtest import wait_for
 from std_msgs.msg import Bool
 from std_srvs.srv import Empty
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from simtest import wait_for  # noqa: E402
 
 RUN = 12.0  # s of sim time
 # m: fast vs real time, at the same sim times. Typically 0.6-1.7 cm; a tick that reads the wall ahead just

@@ -37,10 +37,8 @@ from gazebo_msgs.srv import DeleteModel, SpawnModel
 from geometry_msgs.msg import Point, Pose, Quaternion, Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
+from simtest import GOAL_MARKER_SDF, agent_work, figure, wait_for, yaw_of
 from std_srvs.srv import Empty
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from simtest import GOAL_MARKER_SDF, agent_work, figure, wait_for, yaw_of  # noqa: E402
 
 SCAN_PERIOD_NS = 200_000_000  # laser_robot.urdf's 5 Hz laser
 MIN_PATH = 0.3  # m the body must travel over the run for the comparison to mean something

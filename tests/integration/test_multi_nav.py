@@ -40,10 +40,10 @@ from actionlib_msgs.msg import GoalStatus
 from gazebo_msgs.msg import ModelStates
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from nav_msgs.msg import OccupancyGrid
+from simtest import Latest, TfEdges, action_done, figure, wait_for, yaw_of
 
 from diffbot_sim.check import map_check
 from diffbot_sim.world.loading import load_world
-from simtest import Latest, TfEdges, action_done, figure, wait_for, yaw_of
 
 #: tb3like's footprint as seen from above (its collision shapes: the 0.138 m box about (-0.032, 0) and the two
 #: wheels, r 0.033 m and 0.018 m wide at y +-0.080), as the convex outline [x, y] in base_footprint.
@@ -153,7 +153,7 @@ class MultiNavTest(unittest.TestCase):
                                   (f"{name}/base_footprint", f"{name}/base_link"),
                                   (f"{name}/base_link", f"{name}/base_scan")):
                 self.assertIn((parent, child), edges, f"no TF edge {parent} -> {child} (edges: {sorted(edges)})")
-        self.assertFalse(any("odom" == child for _, child in edges), "an unprefixed odom frame in TF")
+        self.assertFalse(any(child == "odom" for _, child in edges), "an unprefixed odom frame in TF")
 
     def check_no_contact(self):
         gap, moment = self.fleet.smallest_gap()

@@ -34,8 +34,7 @@ from gazebo_msgs.srv import GetModelState, GetWorldProperties
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, JointState, LaserScan
-from simtest import Latest, assert_upright, sim_now, yaw_of
-from simtest import wait_for as wait
+from simtest import Latest, assert_upright, sim_now, wait_for as wait, yaw_of
 from tf2_msgs.msg import TFMessage
 
 #: The robot (tb3like_description): base_scan 0.032 m behind base_footprint and 0.181 m above it.

@@ -11,7 +11,8 @@ box of ~avoid_size [depth, width] m about the model's pose, must stay above ~bod
 towards it (a Gazebo actor walks blind and may walk into a robot that stands); ground truth from
 /gazebo/model_states, whose twists are in the world frame),
 ~yaw_tolerance (0.35), ~goal_timeout (sim s, 180), ~truth_topic (the simulator's ground truth,
-/bullet_sim/ground_truth; /gazebo/<model>/ground_truth for a model spawned under the gazebo_ros drop-in), ~scan_frame (base_scan). Figures: time to each goal, its error, sim/wall time, RTF.
+/bullet_sim/ground_truth; /gazebo/<model>/ground_truth for a model spawned under the gazebo_ros drop-in),
+~scan_frame (base_scan). Figures: time to each goal, its error, sim/wall time, RTF.
 """
 import math
 import sys
@@ -27,9 +28,9 @@ from geometry_msgs.msg import PoseWithCovarianceStamped
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from rosgraph_msgs.msg import Clock, Log
 from sensor_msgs.msg import LaserScan
+from simtest import TfEdges, Truth, figure, wait_for
 
 from diffbot_sim.check.drive_check import wrap
-from simtest import TfEdges, Truth, figure, wait_for
 
 NODES = ("/amcl", "/move_base")
 CLOSING_SPEED = 0.02  # m/s: the body counts as driving towards a model of ~avoid above this
@@ -156,7 +157,8 @@ class NavigationTest(unittest.TestCase):
             goal.target_pose.header.frame_id = "map"
             goal.target_pose.header.stamp = rospy.Time.now()
             goal.target_pose.pose.position.x, goal.target_pose.pose.position.y = x, y
-            goal.target_pose.pose.orientation.z, goal.target_pose.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+            orientation = goal.target_pose.pose.orientation
+            orientation.z, orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
             started, wall_started = rospy.get_time(), time.monotonic()
             self.client.send_goal(goal)
             # Sim time bounds the wait; a wall bound keeps a stalled simulator from hanging the suite, and a
@@ -175,8 +177,9 @@ class NavigationTest(unittest.TestCase):
             amcl = f", amcl's belief {math.hypot(body.x - belief[0], body.y - belief[1]) * 100:.1f} cm off the body" \
                 if belief else ""
 
-            figure(f"goal ({x}, {y}, {yaw}): {GoalStatus.to_string(state) if hasattr(GoalStatus, 'to_string') else state} "
-                   f"in {took:.1f} s sim ({wall:.1f} s wall), body {error * 100:.1f} cm and {yaw_error:.3f} rad off{amcl}")
+            status = GoalStatus.to_string(state) if hasattr(GoalStatus, "to_string") else state
+            figure(f"goal ({x}, {y}, {yaw}): {status} in {took:.1f} s sim ({wall:.1f} s wall), body "
+                   f"{error * 100:.1f} cm and {yaw_error:.3f} rad off{amcl}")
             if len(goals) == 1:  # a batch scenario's goal (tests/rostest/nav_goal.test): for results.jsonl
                 print(f"METRIC time_to_goal_s={took:.3f}\nMETRIC goal_error_m={error:.4f}\n"
                       f"METRIC goal_yaw_error_rad={yaw_error:.4f}", flush=True)

@@ -11,10 +11,11 @@ default 0), ~skid (bool, default false): a four-wheel robot driven as a diff dri
 wheels say (its wheels slide sideways; real YAMLs carry a wheel_separation_multiplier for it), so in the turn
 its ground truth need only turn the right way by a quarter of the command, while its own odometry must still
 read the commanded turn; ~wheel_centre ([x, y] in the root link's frame, m; default the origin): the middle of
-the drive wheels, which is what turns in place; ~footprint ([half length, half width] of a skid-steered wheel set, m): its body may turn
-about any point inside it (drive_check.skid_turn_drift), else its origin must stay within 0.1 m; ~odom_is_truth (bool, default false): the drive's odometry is the
-world pose (gazebo_ros_skid_steer_drive), so in the turn it is held to the ground truth's bounds; ~holonomic
-(bool, default false): also 0.2 m/s sideways (linear.y) for 4 s: 0.8 m to the robot's left, heading kept;
+the drive wheels, which is what turns in place; ~footprint ([half length, half width] of a skid-steered wheel
+set, m): its body may turn about any point inside it (drive_check.skid_turn_drift), else its origin must stay
+within 0.1 m; ~odom_is_truth (bool, default false): the drive's odometry is the world pose
+(gazebo_ros_skid_steer_drive), so in the turn it is held to the ground truth's bounds; ~holonomic (bool, default
+false): also 0.2 m/s sideways (linear.y) for 4 s: 0.8 m to the robot's left, heading kept;
 ~imu_topic (optional): the base IMU a drive plugin publishes reads +9.81 m/s^2 on z and no yaw rate at rest
 (REP 145). The launch file starts bullet_sim paused; this node unpauses it once it listens.
 Callbacks only record; waits poll with deadlines; times are sim time. The motions and the body are judged by
@@ -190,7 +191,8 @@ class RealRobotTest(unittest.TestCase):
             self.stop()
             self.assert_ride(body, height, "driving sideways")
             strafe = drive_check.strafe(pose_of(o0), pose_of(o1), pose_of(t0), pose_of(t1), tolerance=tolerance)
-            rospy.loginfo(f"FIGURE sideways: odometry {strafe.odom_left:.3f} m, truth {strafe.truth_left:.3f} m to the left")
+            rospy.loginfo(f"FIGURE sideways: odometry {strafe.odom_left:.3f} m, truth {strafe.truth_left:.3f} m to the "
+                          "left")
             self.assertTrue(strafe.passed, "; ".join(strafe.failures))
 
         (o0, t0), (o1, t1), body = self.drive(0.0, TURN, SECONDS)

@@ -19,8 +19,8 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, NavSatFix
 from simtest import wait_for
 
-from diffbot_sim.transforms import yaw_from_quaternion
 from diffbot_sim.plugins.gps import radii
+from diffbot_sim.transforms import yaw_from_quaternion
 
 SIM = "/bullet_sim"
 G = 9.81

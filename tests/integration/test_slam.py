@@ -6,7 +6,8 @@ map_server's map_saver saves it as a user would.
 
 Private parameters: ~world (the world file the simulator loaded), ~laser_height (m above the ground: where the
 world is cut), ~timeout (wall s for the tour), ~save_as (optional: also keep
-the saved map as this path's .yaml and .pgm, e.g. to make worlds/room_map.yaml). Figures: FIGURE lines (map error, obstacles, sim/wall seconds, RTF).
+the saved map as this path's .yaml and .pgm, e.g. to make worlds/room_map.yaml). Figures: FIGURE lines (map error,
+obstacles, sim/wall seconds, RTF).
 """
 import os
 import shutil
@@ -20,10 +21,10 @@ import unittest
 import rospy
 import rostest
 from nav_msgs.msg import OccupancyGrid
+from simtest import figure, wait_for
 
 from diffbot_sim.check import map_check
 from diffbot_sim.world.loading import load_world
-from simtest import figure, wait_for
 
 
 class SlamTest(unittest.TestCase):
@@ -51,7 +52,8 @@ class SlamTest(unittest.TestCase):
         wait_for(lambda: rospy.get_param("/tour/done", False), timeout, "the tour to end (/tour/done)")
         done_at = rospy.get_time()
         wall = time.monotonic() - wall0
-        figure(f"tour: {done_at - sim0:.1f} s of sim time in {wall:.1f} s of wall time: RTF {(done_at - sim0) / wall:.2f}")
+        figure(f"tour: {done_at - sim0:.1f} s of sim time in {wall:.1f} s of wall time: "
+               f"RTF {(done_at - sim0) / wall:.2f}")
         msg = wait_for(lambda: (m := self.latest_map()) is not None and m.header.stamp.to_sec() > done_at and m,
                        120.0, "a map published after the tour")
         grid = map_check.Grid.from_message(msg)

@@ -18,7 +18,8 @@ services stay fast: for each call the quick end of its wall times (the 10th perc
 iterations is at most MAX_SLOWDOWN times that over the second 10 %. The quick end, not the median: a slowdown the
 simulator causes (something growing with each call) moves every call, the quickest too, while a machine that got
 busier between the two windows moves the median (measured: medians 5.0 -> 7.5 ms with a chroot installing packages
-beside it, the simulator's loop waiting for a CPU 17-24 % of the time). FIGURE lines give the calls per second and every checkpoint.
+beside it, the simulator's loop waiting for a CPU 17-24 % of the time). FIGURE lines give the calls per second and
+every checkpoint.
 """
 import os
 import statistics
@@ -33,10 +34,8 @@ import rospy
 import rostest
 from gazebo_msgs.srv import DeleteModel, SpawnModel
 from geometry_msgs.msg import Point, Pose, Quaternion
+from simtest import GOAL_MARKER_SDF, SIM, figure, node_pid, rss_kib, run_delay
 from std_srvs.srv import Empty
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from simtest import GOAL_MARKER_SDF, SIM, figure, node_pid, rss_kib, run_delay  # noqa: E402
 
 CALLER = "/test_slow_resets"
 CHECKPOINTS = 10

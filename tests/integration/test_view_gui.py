@@ -26,14 +26,12 @@ import time
 import numpy as np
 import rospy
 import rostest
+import viewtest
 from gazebo_msgs.msg import ModelState
 from gazebo_msgs.srv import DeleteModel, GetModelState, GetWorldProperties, SetModelState
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import viewtest  # noqa: E402
-
-from diffbot_sim.view import xscreen  # noqa: E402
-from diffbot_sim.waiting import wait_for  # noqa: E402
+from diffbot_sim.view import xscreen
+from diffbot_sim.waiting import wait_for
 
 ROOM = os.path.join(viewtest.ROOT, "worlds", "room.world")
 ROBOT = "diffbot"  # the seed robot's URDF name: its model name

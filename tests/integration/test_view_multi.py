@@ -12,10 +12,8 @@ import tempfile
 
 import rospy
 import rostest
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import viewtest  # noqa: E402
-from test_view_rviz import ViewRviz  # noqa: E402
+import viewtest
+from test_view_rviz import ViewRviz
 
 ROBOT2 = (0.0, 1.0)  # m, multi.launch's spawn pose of robot2; robot1 (the fixed frame's) is at the origin
 

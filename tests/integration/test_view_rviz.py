@@ -23,12 +23,10 @@ import time
 import numpy as np
 import rospy
 import rostest
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import viewtest  # noqa: E402
+import viewtest
 
 from diffbot_sim.view import (
-    rviz_config,  # noqa: E402
+    rviz_config,
     xscreen,
 )
 
@@ -45,7 +43,9 @@ SCAN_GREEN = np.array([int(c) for c in rviz_config.SCAN_COLOR.split(";")], dtype
 CENTRE_TOLERANCE = 0.05
 DRIVE = 1.0  # m the robot drives forward between the two pictures (to x = 1, clear of the east wall at 2.9)
 DRIVE_TIMEOUT = 60.0  # s wall: 2.5 s of sim time at 0.4 m/s, on a machine where the simulator runs slower
-PATCH_RADIUS = 0.3  # m: the robot's top fits in this circle (half-diagonal 0.16 m), the next wall does not  # m: the laser and camera visuals shift the patch's centre forward ~1 cm
+#: m: the robot's top fits in this circle (half-diagonal 0.16 m), the next wall does not; the laser and camera
+#: visuals shift the patch's centre forward ~1 cm
+PATCH_RADIUS = 0.3
 
 
 class ViewRviz(viewtest.PictureSuite):
@@ -153,8 +153,8 @@ class ViewRviz(viewtest.PictureSuite):
                     viewtest.save_frame(pixels, "settle_after")
             if moved < 0 or moved > SETTLE_CHANGED:
                 cls.why = ("the 3-D panel moved or was resized" if moved < 0 else
-                            f"the 3-D view changed in {moved} pixels (> {SETTLE_CHANGED}) outside the laser points between "
-                            "screenshots, "
+                            f"the 3-D view changed in {moved} pixels (> {SETTLE_CHANGED}) outside the laser points "
+                            "between screenshots, "
                             f"within the panel's pixels {where} (rviz still drawing, or something still moving; "
                             "settle_before/after.png in ROS_HOME)")
                 history[:] = history[-1:]

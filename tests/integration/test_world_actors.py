@@ -3,7 +3,6 @@
 sim time) and the laser sees it there (Gazebo's CPU lasers do not); a model moved by /gazebo/set_model_state at
 30 Hz, as learning stages move obstacles, is seen at the pose set."""
 import math
-import os
 import sys
 import threading
 import unittest
@@ -14,9 +13,7 @@ from gazebo_msgs.msg import ModelState, ModelStates
 from gazebo_msgs.srv import GetModelState
 from geometry_msgs.msg import Pose
 from sensor_msgs.msg import LaserScan
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from simtest import wait_for  # noqa: E402
+from simtest import wait_for
 
 LASER_X, LASER_Z = 0.0, 0.113  # laser_robot.urdf: the laser's frame over the robot's origin
 NEAR_FACE = 1.75  # m: the walker's near face (x = 2.0 - half its 0.5 m width)

@@ -36,7 +36,7 @@ class Sleeper(unittest.TestCase):
     def test_outcome(self):
         outcome = rospy.get_param("~outcome", "pass")
         time.sleep(float(rospy.get_param("~seconds", 0.5)))
-        print("METRIC slept_s=%s" % rospy.get_param("~seconds", 0.5), flush=True)
+        print("METRIC slept_s={}".format(rospy.get_param("~seconds", 0.5)), flush=True)
         if outcome == "fail":
             self.fail("told to fail")
         if outcome == "crash":

@@ -22,7 +22,8 @@ print(json.dumps(out))
 """
 # rosrun itself, non-interactively: one line and status 0 means it resolved the name to one executable
 # (a devel-space relay plus its source script counts as one, as rosrun treats it).
-ROSRUN = "for n in bullet_sim teleop_key test_drive.py; do rosrun --prefix 'echo RESOLVED' diffbot_sim $n </dev/null || echo FAILED $n; done"
+ROSRUN = ("for n in bullet_sim teleop_key test_drive.py; do "
+          "rosrun --prefix 'echo RESOLVED' diffbot_sim $n </dev/null || echo FAILED $n; done")
 
 
 def probe(setup_bash):

@@ -116,7 +116,8 @@ def difference(reference, other):
     worst_key, worst = max(differing, key=lambda item: item[1])
     row, ref = other[(episode, stamp)], reference[(episode, stamp)]
     return (f"{len(differing)} of {len(reference)} poses differ; first at episode {episode} step {row['step']} "
-            f"(sim {stamp / 1e9:.4f} s) by {first:.3g} (dx {row['x'] - ref['x']:.3g} m, dy {row['y'] - ref['y']:.3g} m, "
+            f"(sim {stamp / 1e9:.4f} s) by {first:.3g} (dx {row['x'] - ref['x']:.3g} m, "
+            f"dy {row['y'] - ref['y']:.3g} m, "
             f"dyaw {row['yaw'] - ref['yaw']:.3g} rad); worst {worst:.3g} at episode {worst_key[0]} sim "
             f"{worst_key[1] / 1e9:.4f} s")
 

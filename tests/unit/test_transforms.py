@@ -124,7 +124,8 @@ def test_yaw_from_quaternion_matches_pybullet():
 
 
 @pytest.mark.parametrize("angle, turn", [(0.0, 0.0), (math.pi / 2, math.pi / 2), (3 * math.pi / 2, -math.pi / 2),
-                                         (-3 * math.pi / 2, math.pi / 2), (2 * math.pi + 0.1, 0.1), (-7.0, -7.0 + 2 * math.pi)])
+                                         (-3 * math.pi / 2, math.pi / 2), (2 * math.pi + 0.1, 0.1),
+                                         (-7.0, -7.0 + 2 * math.pi)])
 def test_wrap_angle(angle, turn):
     """A heading difference as the turn it is (the tour steers by it, drive checks judge by it)."""
     assert wrap_angle(angle) == pytest.approx(turn)

@@ -13,6 +13,7 @@ from benchkit.bare import check_upright, load, wheel_speeds
 from benchkit.common import CIRCLE, ROBOTS, STEP
 from benchkit.launching import Launch, sim_args, subscriber
 from benchkit.report import Item
+
 from diffbot_sim.waiting import wait_for
 
 ARM_MODEL = os.path.join(ROBOTS, "mobile_arm6.urdf.xacro")

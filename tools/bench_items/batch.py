@@ -63,7 +63,8 @@ def rows(r):
              f"{b['through_batch_s'] - b['rostest_alone_s']:.2f} s", "< 1 s"),
             ("batch: drive runs per hour per core, --jobs 1 / --jobs 2",
              f"{b['jobs1']['runs_per_hour_per_core']:.0f} / {b['jobs2']['runs_per_hour_per_core']:.0f}", ""),
-            ("  speed-up of --jobs 2 over --jobs 1 (2 cores)", f"{b['jobs1']['wall_s'] / b['jobs2']['wall_s']:.2f}", "")]
+            ("  speed-up of --jobs 2 over --jobs 1 (2 cores)", f"{b['jobs1']['wall_s'] / b['jobs2']['wall_s']:.2f}",
+             "")]
 
 
 ITEMS = [Item("batch", lambda q: batch(2 if q else 5), rows)]

@@ -20,6 +20,7 @@ from benchkit.common import MODEL, ROBOTS, STEP, TOPICS
 from benchkit.launching import Launch, sim_args, subscriber
 from benchkit.report import Item
 from benchkit.stats import median_trial, percentile
+
 from diffbot_sim.waiting import wait_for
 
 ROS_CONTROL_MODEL = os.path.join(ROBOTS, "ros_control_4wd.urdf")
@@ -177,7 +178,8 @@ def fast_rows(r):
             ("fast-mode RTF, robot_state_publisher:=false", f"{n['rtf']:.1f}", ">= 40"),
             ("  fast / bare", f"{n['rtf'] / b['rtf']:.2f}", ">= 0.5")]
     if r.get("fast_commander"):
-        rows.append(("  the same, a rospy node publishing cmd_vel in the loop", f"{r['fast_commander']['rtf']:.1f}", ""))
+        rows.append(("  the same, a rospy node publishing cmd_vel in the loop", f"{r['fast_commander']['rtf']:.1f}",
+                     ""))
     return rows
 
 
@@ -193,7 +195,8 @@ def realtime_rows(r):
                       f"{rt['odom_period_p99_ms']:.2f} ms", ""),
                      ("  /odom delivery jitter p99", f"{rt['odom_jitter_p99_ms']:.2f} ms", "")]
     if r.get("bare_paced"):
-        rows.append(("bare PyBullet paced to real time, CPU (the floor)", f"{r['bare_paced']['cpu_percent']:.1f} % of a core", ""))
+        rows.append(("bare PyBullet paced to real time, CPU (the floor)",
+                     f"{r['bare_paced']['cpu_percent']:.1f} % of a core", ""))
     return rows
 
 

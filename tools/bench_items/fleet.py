@@ -216,7 +216,8 @@ def fleet(seconds):
         out[key]["ratio_to_bare"] = round(statistics.median([p["ratio"] for p in runs]), 3)
     physics = {n: bare_fleet(n, 5.0, laser_model, False) for n in (40, 60)}
     physics_count = round(statistics.median([n * r for n, r in physics.items()]), 1)
-    out.update({"pairs": pairs, "bare_physics_only_rtf": physics, "bare_physics_only_robots_at_real_time": physics_count})
+    out.update({"pairs": pairs, "bare_physics_only_rtf": physics,
+                "bare_physics_only_robots_at_real_time": physics_count})
     return out
 
 
@@ -247,7 +248,8 @@ def fleet_rows(r):
             ("  the same without lasers", f"{f['no_laser']['robots_at_real_time']}", ""),
             ("  with lasers + a robot_state_publisher each", f"{f['laser_rsp']['robots_at_real_time']}", ""),
             ("  bare PyBullet, physics only (no rays)", f"{f['bare_physics_only_robots_at_real_time']:.0f}", ""),
-            ("  simulator cost per robot (lasers), CPU us per sim s", f"{laser['us_per_robot_per_sim_s'] or 0:.0f}", "")]
+            ("  simulator cost per robot (lasers), CPU us per sim s", f"{laser['us_per_robot_per_sim_s'] or 0:.0f}",
+             "")]
 
 
 # scale_rsp's rows are scale_rows' second line

@@ -17,6 +17,7 @@ from benchkit.common import ROBOTS, ROOT
 from benchkit.launching import Launch, sim_args
 from benchkit.report import Item
 from benchkit.stats import percentile
+
 from diffbot_sim.waiting import wait_for
 
 LASER_ROBOT = os.path.join(ROBOTS, "laser_robot.urdf")

@@ -98,8 +98,9 @@ def mesh_world(models=30, segments=64):
 
 def worlds(runs, seconds):
     """Load times of a mesh world and of 4000 x 4000 maps; RTF in the example world against none."""
-    from diffbot_sim.world import map_image as world_map
     from run_tests import MULTI_FIXTURES, add_package_path  # tools/run_tests.py: the test suites' fixture packages
+
+    from diffbot_sim.world import map_image as world_map
     out = {}
     home = os.path.join(RESULTS, "ros_home_worlds")
     cache = os.path.join(home, "diffbot_sim", "mesh_cache")

@@ -10,6 +10,7 @@ from benchkit.common import ROBOTS
 from benchkit.launching import Launch
 from benchkit.report import Item
 from benchkit.stats import percentile
+
 from diffbot_sim.waiting import wait_for
 
 

@@ -1,11 +1,11 @@
 """An item's record, the results file (bench-results/bench.json) and the printed table."""
 import json
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable, List, Optional, Tuple
 
 #: one row of the table: (measure, value, target)
-Row = Tuple[str, str, str]
+Row = tuple[str, str, str]
 
 
 @dataclass
@@ -20,9 +20,9 @@ class Item:
 
     name: str
     run: Callable[[bool], dict]
-    rows: Callable[[dict], List[Row]]
+    rows: Callable[[dict], list[Row]]
     flat: bool = False
-    part_of: Optional[str] = None
+    part_of: str | None = None
 
     def wanted(self, names):
         return self.name in names or (self.part_of is not None and self.part_of in names)

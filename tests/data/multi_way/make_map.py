@@ -13,9 +13,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "..", "src"))
 os.environ["ROS_PACKAGE_PATH"] = os.pathsep.join([HERE, os.environ.get("ROS_PACKAGE_PATH", "")])
 
-from diffbot_sim.check import map_check  # noqa: E402
-from diffbot_sim.world import map_image  # noqa: E402
-from diffbot_sim.world.loading import load_world  # noqa: E402
+from diffbot_sim.check import map_check
+from diffbot_sim.world import map_image
+from diffbot_sim.world.loading import load_world
 
 LASER_HEIGHT = 0.181  # m: tb3like's base_scan above the ground
 RESOLUTION = 0.05  # m, gmapping's default delta

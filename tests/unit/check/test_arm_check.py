@@ -9,20 +9,28 @@ from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.physics import World
 
 ARM = """<robot name="arm">
-  <link name="base"><inertial><mass value="5"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
-  <link name="upper"><inertial><origin xyz="0 0 0.1"/><mass value="0.3"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-4"/></inertial></link>
-  <link name="fore"><inertial><mass value="0.2"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-4"/></inertial></link>
+  <link name="base"><inertial><mass value="5"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/>
+    </inertial></link>
+  <link name="upper"><inertial><origin xyz="0 0 0.1"/><mass value="0.3"/>
+    <inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-4"/></inertial></link>
+  <link name="fore"><inertial><mass value="0.2"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-4"/>
+    </inertial></link>
   <link name="hand"/>
-  <link name="finger"><inertial><mass value="0.02"/><inertia ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" iyz="0" izz="1e-6"/></inertial></link>
-  <link name="finger2"><inertial><mass value="0.02"/><inertia ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" iyz="0" izz="1e-6"/></inertial></link>
-  <joint name="yaw" type="continuous"><parent link="base"/><child link="upper"/><origin xyz="0 0 0.2"/><axis xyz="0 0 1"/></joint>
+  <link name="finger"><inertial><mass value="0.02"/>
+    <inertia ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" iyz="0" izz="1e-6"/></inertial></link>
+  <link name="finger2"><inertial><mass value="0.02"/>
+    <inertia ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" iyz="0" izz="1e-6"/></inertial></link>
+  <joint name="yaw" type="continuous"><parent link="base"/><child link="upper"/><origin xyz="0 0 0.2"/>
+    <axis xyz="0 0 1"/></joint>
   <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/><origin xyz="0 0 0.25" rpy="0 0.3 0"/>
     <axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="5" velocity="2"/></joint>
-  <joint name="wrist_fixed" type="fixed"><parent link="fore"/><child link="hand"/><origin xyz="0.2 0 0" rpy="0.1 0 0.2"/></joint>
+  <joint name="wrist_fixed" type="fixed"><parent link="fore"/><child link="hand"/>
+    <origin xyz="0.2 0 0" rpy="0.1 0 0.2"/></joint>
   <joint name="slide" type="prismatic"><parent link="hand"/><child link="finger"/><origin xyz="0 0.02 0"/>
     <axis xyz="0 1 0"/><limit lower="0" upper="0.05" effort="5" velocity="1"/></joint>
   <joint name="slide2" type="prismatic"><parent link="hand"/><child link="finger2"/><origin xyz="0 -0.02 0"/>
-    <axis xyz="0 -1 0"/><limit lower="0" upper="0.05" effort="5" velocity="1"/><mimic joint="slide" multiplier="1"/></joint>
+    <axis xyz="0 -1 0"/><limit lower="0" upper="0.05" effort="5" velocity="1"/><mimic joint="slide" multiplier="1"/>
+      </joint>
 </robot>"""
 
 

@@ -32,7 +32,8 @@ def report(tmp_path):
             path = str(tmp_path / model)
             with open(path, "w") as handle:
                 handle.write(text)
-        return robot_report.build_report(path, "", controllers(*yamls), KNOWN, KNOWN_SENSORS, cache_dir=str(tmp_path / "cache"))
+        return robot_report.build_report(path, "", controllers(*yamls), KNOWN, KNOWN_SENSORS,
+                                         cache_dir=str(tmp_path / "cache"))
     return build
 
 

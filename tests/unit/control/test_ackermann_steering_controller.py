@@ -7,8 +7,12 @@ import math
 
 import pytest
 
-from diffbot_sim.control.ackermann_steering_controller import (AckermannOdometry, AckermannSteeringCore,
-                                                               ackermann_config, turning_radius)
+from diffbot_sim.control.ackermann_steering_controller import (
+    AckermannOdometry,
+    AckermannSteeringCore,
+    ackermann_config,
+    turning_radius,
+)
 from diffbot_sim.errors import ConfigError
 
 NS = "/ackermann_steering_bot_controller"

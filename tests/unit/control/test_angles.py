@@ -5,8 +5,14 @@ import math
 import pytest
 
 from diffbot_sim.control.angles import (
-    find_min_max_delta, normalize_angle, normalize_angle_positive, shortest_angular_distance,
-    shortest_angular_distance_with_large_limits, shortest_angular_distance_with_limits, two_pi_complement)
+    find_min_max_delta,
+    normalize_angle,
+    normalize_angle_positive,
+    shortest_angular_distance,
+    shortest_angular_distance_with_large_limits,
+    shortest_angular_distance_with_limits,
+    two_pi_complement,
+)
 
 PI = math.pi
 EPS = 1e-9

@@ -6,8 +6,11 @@ import math
 
 import pytest
 
-from diffbot_sim.control.diff_drive_config import (CONTROLLER_TYPE, DiffDriveControllerConfig,
-                                                   diff_drive_controller_config)
+from diffbot_sim.control.diff_drive_config import (
+    CONTROLLER_TYPE,
+    DiffDriveControllerConfig,
+    diff_drive_controller_config,
+)
 from diffbot_sim.errors import ConfigError
 
 NS = "/diffbot_controller"

@@ -10,7 +10,7 @@ import math
 import pytest
 
 from diffbot_sim.control.diff_drive_config import diff_drive_controller_config
-from diffbot_sim.control.diff_drive_controller import DiffDriveControllerStep, DiffDriveControllerCore
+from diffbot_sim.control.diff_drive_controller import DiffDriveControllerCore, DiffDriveControllerStep
 from diffbot_sim.errors import ConfigError
 
 NS = "/diffbot_controller"

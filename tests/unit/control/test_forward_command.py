@@ -4,8 +4,18 @@ import math
 import pytest
 
 from diffbot_sim.control.forward_command import (
-    CONTROLLER_TYPES, ForwardCommandCore, JointControllerState, JointSpec, PidPositionCore, PidVelocityCore,
-    clamp_to_urdf_limits, dimension_error, forward_config, make_core, position_error)
+    CONTROLLER_TYPES,
+    ForwardCommandCore,
+    JointControllerState,
+    JointSpec,
+    PidPositionCore,
+    PidVelocityCore,
+    clamp_to_urdf_limits,
+    dimension_error,
+    forward_config,
+    make_core,
+    position_error,
+)
 from diffbot_sim.control.pid import PidGains
 from diffbot_sim.description.urdf_model import Joint
 from diffbot_sim.errors import ConfigError

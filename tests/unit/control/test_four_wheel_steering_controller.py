@@ -5,10 +5,17 @@ import math
 
 import pytest
 
-from diffbot_sim.control.four_wheel_steering_controller import (FourWheelSteeringCore, Geometry, axle_steering,
-                                                                four_wheel_steering_commands,
-                                                                four_wheel_steering_config, joint_distance,
-                                                                joint_offset, resolve_geometry, twist_commands)
+from diffbot_sim.control.four_wheel_steering_controller import (
+    FourWheelSteeringCore,
+    Geometry,
+    axle_steering,
+    four_wheel_steering_commands,
+    four_wheel_steering_config,
+    joint_distance,
+    joint_offset,
+    resolve_geometry,
+    twist_commands,
+)
 from diffbot_sim.errors import ConfigError
 
 NS = "/four_wheel_steering_controller"

@@ -5,7 +5,7 @@ import math
 
 import pytest
 
-from diffbot_sim.control.gazebo_diff_drive import TWIST_FIELDS, GazeboDiffDriveCore, DriveWheels, non_finite_field
+from diffbot_sim.control.gazebo_diff_drive import TWIST_FIELDS, DriveWheels, GazeboDiffDriveCore, non_finite_field
 from diffbot_sim.control.kinematics import body_velocity
 
 SEP, RAD, VMAX = 0.2, 0.032, 40.0  # the seed: max_linear = 1.28 m/s, max angular = 12.8 rad/s

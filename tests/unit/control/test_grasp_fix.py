@@ -4,8 +4,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from diffbot_sim.control.grasp_fix import (
-    GraspContact, GraspFixCore, check_grip, grasp_contact, grasp_fix_config)
+from diffbot_sim.control.grasp_fix import GraspContact, GraspFixCore, check_grip, grasp_contact, grasp_fix_config
 from diffbot_sim.errors import ConfigError, PluginNotLoaded
 
 PATH = "/robot/gazebo[4]/plugin[@name='gazebo_grasp_fix']"

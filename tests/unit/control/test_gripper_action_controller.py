@@ -4,8 +4,17 @@ import math
 import pytest
 
 from diffbot_sim.control.gripper_action_controller import (
-    ABORTED, EFFORT_TYPE, NO_GAINS_WARNING, NOT_RUNNING, POSITION_TYPE, SUCCEEDED, GripperActionCore,
-    GripperResult, gripper_action_config, is_finite_goal)
+    ABORTED,
+    EFFORT_TYPE,
+    NO_GAINS_WARNING,
+    NOT_RUNNING,
+    POSITION_TYPE,
+    SUCCEEDED,
+    GripperActionCore,
+    GripperResult,
+    gripper_action_config,
+    is_finite_goal,
+)
 from diffbot_sim.control.pid import PidGains
 from diffbot_sim.errors import ConfigError
 

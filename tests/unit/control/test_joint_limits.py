@@ -6,9 +6,21 @@ import math
 import pytest
 
 from diffbot_sim.control.joint_limits import (
-    DBL_MAX, EffortJointSaturation, EffortJointSoftLimits, JointLimits, JointLimitsInterfaceError,
-    PositionJointSaturation, PositionJointSoftLimits, SoftJointLimits, VelocityJointSaturation,
-    VelocityJointSoftLimits, apply_rosparam_limits, limits_from_urdf, make_limit_handle, register_joint_limits)
+    DBL_MAX,
+    EffortJointSaturation,
+    EffortJointSoftLimits,
+    JointLimits,
+    JointLimitsInterfaceError,
+    PositionJointSaturation,
+    PositionJointSoftLimits,
+    SoftJointLimits,
+    VelocityJointSaturation,
+    VelocityJointSoftLimits,
+    apply_rosparam_limits,
+    limits_from_urdf,
+    make_limit_handle,
+    register_joint_limits,
+)
 from diffbot_sim.description.urdf_model import Joint, SafetyController
 from diffbot_sim.errors import ConfigError
 

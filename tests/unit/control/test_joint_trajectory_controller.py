@@ -7,8 +7,7 @@ import math
 
 import pytest
 
-from diffbot_sim.control import joint_trajectory_controller as jtc
-from diffbot_sim.control import trajectory as tr
+from diffbot_sim.control import joint_trajectory_controller as jtc, trajectory as tr
 from diffbot_sim.control.joint_trajectory_config import jtc_config
 from diffbot_sim.control.joint_trajectory_controller import ControllerCrash, JointTrajectoryControllerCore
 from diffbot_sim.control.trajectory import TrajectoryPoint as P

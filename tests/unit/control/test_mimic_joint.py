@@ -4,8 +4,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from diffbot_sim.control.mimic_joint import (
-    MimicAction, MimicCore, ignition_clamp, mimic_config, urdf_mimic_target)
+from diffbot_sim.control.mimic_joint import MimicAction, MimicCore, ignition_clamp, mimic_config, urdf_mimic_target
 from diffbot_sim.control.pid import PidGains
 from diffbot_sim.description.urdf_model import Mimic
 from diffbot_sim.errors import ConfigError, PluginNotLoaded

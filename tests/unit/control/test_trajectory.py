@@ -8,9 +8,18 @@ import math
 import pytest
 
 from diffbot_sim.control import trajectory as tr
-from diffbot_sim.control.trajectory import (SegmentTolerances, Segment, SplineState, StateTolerances,
-                                            TrajectoryError, TrajectoryPoint as P, hold_trajectory,
-                                            merge_trajectory, resolve_goal_tolerances, sample)
+from diffbot_sim.control.trajectory import (
+    Segment,
+    SegmentTolerances,
+    SplineState,
+    StateTolerances,
+    TrajectoryError,
+    TrajectoryPoint as P,
+    hold_trajectory,
+    merge_trajectory,
+    resolve_goal_tolerances,
+    sample,
+)
 
 S = 1_000_000_000  # ns per s
 

@@ -258,7 +258,8 @@ def test_transmission_round_trips(n, offset):
 
 @pytest.mark.parametrize("extra, culprit", [
     ('<link name="a"/>', "/robot/link[@name='a']"),
-    ('<link name="c"/><joint name="j" type="fixed"><parent link="a"/><child link="c"/></joint>', "/robot/joint[@name='j']"),
+    ('<link name="c"/><joint name="j" type="fixed"><parent link="a"/><child link="c"/></joint>',
+     "/robot/joint[@name='j']"),
 ])
 def test_a_duplicate_link_or_joint_name_is_refused_by_name(extra, culprit):
     """urdfdom refuses a second link or joint of one name (PyBullet would crash on it): one line naming it."""

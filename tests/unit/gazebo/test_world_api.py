@@ -10,8 +10,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from diffbot_sim.gazebo import model_xml
-from diffbot_sim.gazebo import world_api as api
+from diffbot_sim.gazebo import model_xml, world_api as api
 from diffbot_sim.gazebo.ignition import IDENTITY, quaternion_rpy
 from diffbot_sim.transforms import compose, rpy_quaternion
 

@@ -130,7 +130,7 @@ NOETIC_MD5 = {
 }
 
 PACKAGES = ("gazebo_msgs", "controller_manager_msgs", "control_msgs")
-DEPENDENCY_MSG_DIRS = {p: ["/usr/share/%s/msg" % p] for p in ("std_msgs", "geometry_msgs", "sensor_msgs",
+DEPENDENCY_MSG_DIRS = {p: [f"/usr/share/{p}/msg"] for p in ("std_msgs", "geometry_msgs", "sensor_msgs",
                                                                "trajectory_msgs", "actionlib_msgs")}
 # catkin's add_action_files runs this (Debian's libactionlib-msgs-dev) to turn X.action into seven messages.
 GENACTION = "/usr/lib/actionlib_msgs/genaction.py"
@@ -147,7 +147,7 @@ def _overlay_types(pkg):
     """Every type the overlay package defines: its messages, services and each action's seven messages."""
     names = _overlay_files(pkg, "msg") + _overlay_files(pkg, "srv")
     names += [action + suffix for action in _overlay_files(pkg, "action") for suffix in ACTION_MESSAGE_SUFFIXES]
-    return {"%s/%s" % (pkg, name) for name in names}
+    return {f"{pkg}/{name}" for name in names}
 
 
 @pytest.fixture(scope="module")
@@ -178,12 +178,12 @@ def _generated_class(full_type):
     pkg, name = full_type.split("/")
     sub = "srv" if _is_service(full_type) else "msg"
     try:
-        module = importlib.import_module("%s.%s" % (pkg, sub))
+        module = importlib.import_module(f"{pkg}.{sub}")
     except ImportError:
         if os.environ.get("DIFFBOT_SIM_OVERLAY") == "0":
-            pytest.skip("%s is not installed and DIFFBOT_SIM_OVERLAY=0 leaves the overlay out" % pkg)
-        raise AssertionError("%s.%s does not import: run `make setup` (it builds overlay/%s into "
-                             "catkin_ws/devel) and run the tests through tools/rosenv.sh" % (pkg, sub, pkg))
+            pytest.skip(f"{pkg} is not installed and DIFFBOT_SIM_OVERLAY=0 leaves the overlay out")
+        raise AssertionError(f"{pkg}.{sub} does not import: run `make setup` (it builds overlay/{pkg} into "
+                             "catkin_ws/devel) and run the tests through tools/rosenv.sh") from None
     return getattr(module, name)
 
 
@@ -204,7 +204,7 @@ def test_generated_class_has_noetic_md5(full_type):
     connection's header carries and rospy checks)."""
     cls = _generated_class(full_type)
     assert cls._type == full_type
-    assert cls._md5sum == NOETIC_MD5[full_type], "%s: the built definition is not noetic's" % full_type
+    assert cls._md5sum == NOETIC_MD5[full_type], f"{full_type}: the built definition is not noetic's"
     if _is_service(full_type):
         assert cls._request_class._type == full_type + "Request"
         assert cls._response_class._type == full_type + "Response"
@@ -218,9 +218,9 @@ def test_overlay_source_has_noetic_md5(full_type, action_message_dirs):
 
     missing = [d for dirs in DEPENDENCY_MSG_DIRS.values() for d in dirs if not os.path.isdir(d)]
     if missing:
-        pytest.skip("Debian's .msg definitions are not installed (ros-*-msgs): %s" % ", ".join(missing))
+        pytest.skip("Debian's .msg definitions are not installed (ros-*-msgs): {}".format(", ".join(missing)))
     if action_message_dirs is None:
-        pytest.skip("actionlib_msgs' %s is not installed (libactionlib-msgs-dev)" % GENACTION)
+        pytest.skip(f"actionlib_msgs' {GENACTION} is not installed (libactionlib-msgs-dev)")
     search = dict(DEPENDENCY_MSG_DIRS)
     for pkg in PACKAGES:
         search[pkg] = [os.path.join(OVERLAY, pkg, "msg")]
@@ -240,8 +240,8 @@ def test_constants_are_noetic():
     switch = _generated_class("controller_manager_msgs/SwitchController")._request_class
     assert (switch.BEST_EFFORT, switch.STRICT) == (1, 2)
     joint = _generated_class("gazebo_msgs/GetJointProperties")._response_class
-    assert [joint.REVOLUTE, joint.CONTINUOUS, joint.PRISMATIC, joint.FIXED, joint.BALL, joint.UNIVERSAL] == \
-        list(range(6))
+    assert list(range(6)) == \
+        [joint.REVOLUTE, joint.CONTINUOUS, joint.PRISMATIC, joint.FIXED, joint.BALL, joint.UNIVERSAL]
     result = _generated_class("control_msgs/FollowJointTrajectoryResult")
     assert [result.SUCCESSFUL, result.INVALID_GOAL, result.INVALID_JOINTS, result.OLD_HEADER_TIMESTAMP,
             result.PATH_TOLERANCE_VIOLATED, result.GOAL_TOLERANCE_VIOLATED] == [0, -1, -2, -3, -4, -5]

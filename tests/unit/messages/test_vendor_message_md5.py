@@ -6,7 +6,8 @@ a Kobuki's event listeners or a link-attacher caller connects here only with ups
 UPSTREAM_MD5 was computed with ``genmsg.compute_md5`` from the files of each pinned upstream commit (named in
 each package's README.md), exported to a temporary directory, with Debian's /usr/share/<pkg>/msg for the
 standard dependencies; FourWheelSteeringStamped's value also appears in code others generated from the real
-package (rosserial, genlisp, gennodejs).
+package (rosserial, genlisp, gennodejs), and so do BumperEvent's. An .action is first expanded by Debian's
+actionlib_msgs genaction.py (what catkin's add_action_files runs) into its seven messages.
 """
 import glob
 import importlib
@@ -20,8 +21,35 @@ OVERLAY = os.path.join(ROOT, "overlay")
 UPSTREAM_MD5 = {
     "four_wheel_steering_msgs/FourWheelSteering": "04dd0f55e1f168668af1e2587a7cdd2a",
     "four_wheel_steering_msgs/FourWheelSteeringStamped": "9226582df815bc6df9e3206bc05923af",
+    "kobuki_msgs/AutoDockingAction": "44be114f3afc06365a090db0a5e982b5",
+    "kobuki_msgs/AutoDockingActionFeedback": "6f7132467beab5153587d9ebb8d8262d",
+    "kobuki_msgs/AutoDockingActionGoal": "4b30be6cd12b9e72826df56b481f40e0",
+    "kobuki_msgs/AutoDockingActionResult": "3fb2b9cd9cec6b4cb23b224521dd7679",
+    "kobuki_msgs/AutoDockingFeedback": "03343b6aa0067ce6251bcc08bf318388",
+    "kobuki_msgs/AutoDockingGoal": "d41d8cd98f00b204e9800998ecf8427e",
+    "kobuki_msgs/AutoDockingResult": "74697ed3d931f6eede8bf3a8dfeca160",
+    "kobuki_msgs/BumperEvent": "ffe360cd50f14f9251d9844083e72ac5",
+    "kobuki_msgs/ButtonEvent": "49eca512765dbdec759a79083ffcec8d",
+    "kobuki_msgs/CliffEvent": "c5b106efbb1427a94f517c5e05f06295",
+    "kobuki_msgs/ControllerInfo": "46af38e72f0640f41ed22174d43a2550",
+    "kobuki_msgs/DigitalInputEvent": "93da823c8b121f8a3940ef3830c58e44",
+    "kobuki_msgs/DigitalOutput": "1e97cd7f196a0270516b506e8bf29ca2",
+    "kobuki_msgs/DockInfraRed": "a3d77f7d15e50579473dcc24e9b97b34",
+    "kobuki_msgs/ExternalPower": "95149d524971a4c6d19e64c827307194",
+    "kobuki_msgs/KeyboardInput": "9288b95cb32b48719d84d696be253401",
+    "kobuki_msgs/Led": "4391183b0cf05f8f25d04220401b9f43",
+    "kobuki_msgs/MotorPower": "8f77c0161e0f2021493136bb5f3f0e51",
+    "kobuki_msgs/PowerSystemEvent": "f6464657d6c911b00c7bc7b43a154bf8",
+    "kobuki_msgs/RobotStateEvent": "c6eccd4cb1f95df95635b56d6226ea32",
+    "kobuki_msgs/ScanAngle": "06e2c839dc5c7f5c13ac09a8b4ff0a6a",
+    "kobuki_msgs/SensorState": "430a4bfd78449c8740bfef32b26613a6",
+    "kobuki_msgs/Sound": "dfeab0daae67749c426c1db741a4f420",
+    "kobuki_msgs/VersionInfo": "3dc0ce6edd49be1fc86730f4a4a21861",
+    "kobuki_msgs/WheelDropEvent": "e102837d89384d67669a0df86b63f33b",
 }
 PACKAGES = sorted({name.split("/")[0] for name in UPSTREAM_MD5})
+GENACTION = "/usr/lib/actionlib_msgs/genaction.py"
+ACTION_SUFFIXES = ("Action", "ActionGoal", "ActionResult", "ActionFeedback", "Goal", "Result", "Feedback")
 
 
 def _overlay_types(pkg):
@@ -29,7 +57,26 @@ def _overlay_types(pkg):
     for kind in ("msg", "srv"):
         for path in glob.glob(os.path.join(OVERLAY, pkg, kind, "*." + kind)):
             out.add(f"{pkg}/{os.path.basename(path)[:-len(kind) - 1]}")
+    for path in glob.glob(os.path.join(OVERLAY, pkg, "action", "*.action")):
+        out.update(f"{pkg}/{os.path.basename(path)[:-7]}{suffix}" for suffix in ACTION_SUFFIXES)
     return out
+
+
+@pytest.fixture(scope="module")
+def action_dirs(tmp_path_factory):
+    """{package: the messages genaction makes of the overlay's .action text}."""
+    import subprocess
+    import sys
+
+    dirs = {}
+    for pkg in PACKAGES:
+        actions = glob.glob(os.path.join(OVERLAY, pkg, "action", "*.action"))
+        if actions and os.path.isfile(GENACTION):
+            out = str(tmp_path_factory.mktemp(pkg))
+            for action in actions:
+                subprocess.run([sys.executable, GENACTION, action, "-o", out], check=True, capture_output=True)
+            dirs[pkg] = out
+    return dirs
 
 
 def test_table_covers_every_definition():
@@ -37,14 +84,14 @@ def test_table_covers_every_definition():
 
 
 @pytest.mark.parametrize("full_type", sorted(UPSTREAM_MD5))
-def test_overlay_text_hashes_to_upstreams_md5(full_type):
-    genmsg = pytest.importorskip("genmsg")
+def test_overlay_text_hashes_to_upstreams_md5(full_type, action_dirs):
+    pytest.importorskip("genmsg")
     import genmsg.gentools
     import genmsg.msg_loader
 
     pkg, name = full_type.split("/")
-    search = {p: [os.path.join(OVERLAY, p, "msg")] for p in PACKAGES}
-    for dep in ("std_msgs", "geometry_msgs", "sensor_msgs"):
+    search = {p: [os.path.join(OVERLAY, p, "msg")] + ([action_dirs[p]] if p in action_dirs else []) for p in PACKAGES}
+    for dep in ("std_msgs", "geometry_msgs", "sensor_msgs", "actionlib_msgs"):
         search[dep] = [f"/usr/share/{dep}/msg"]
     ctx = genmsg.MsgContext.create_default()
     if os.path.exists(os.path.join(OVERLAY, pkg, "srv", name + ".srv")):
@@ -67,5 +114,6 @@ def test_built_classes_carry_upstreams_md5(full_type):
     except ImportError:
         if os.environ.get("DIFFBOT_SIM_OVERLAY") == "0":
             pytest.skip(f"{pkg} is not installed and DIFFBOT_SIM_OVERLAY=0 leaves the overlay out")
-        raise AssertionError(f"{pkg}.{sub} does not import: run `make setup` and the tests through tools/rosenv.sh")
+        raise AssertionError(f"{pkg}.{sub} does not import: run `make setup` and the tests through "
+                             "tools/rosenv.sh") from None
     assert getattr(module, name)._md5sum == UPSTREAM_MD5[full_type]

@@ -6,7 +6,6 @@ import os
 import pybullet
 import pytest
 
-from diffbot_sim import physics
 from diffbot_sim.control.gazebo_diff_drive import GazeboDiffDriveCore
 from diffbot_sim.control.odometry import EncoderOdometry
 from diffbot_sim.description import lumping

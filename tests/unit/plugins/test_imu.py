@@ -87,8 +87,10 @@ def test_gazebo_ros_imu_model_plugin_tags():
 def test_hector_imu_tags_defaults_and_heading_tags_ignored():
     el = ET.fromstring('<plugin name="imu_controller" filename="libhector_gazebo_ros_imu.so">'
                        '<updateRate>50.0</updateRate><bodyName>base_link</bodyName><topicName>imu/data</topicName>'
-                       '<accelDrift>0.005 0.005 0.005</accelDrift><accelGaussianNoise>0.005 0.005 0.005</accelGaussianNoise>'
-                       '<rateDrift>0.005 0.005 0.005 </rateDrift><rateGaussianNoise>0.005 0.005 0.005</rateGaussianNoise>'
+                       '<accelDrift>0.005 0.005 0.005</accelDrift>'
+                       '<accelGaussianNoise>0.005 0.005 0.005</accelGaussianNoise>'
+                       '<rateDrift>0.005 0.005 0.005 </rateDrift>'
+                       '<rateGaussianNoise>0.005 0.005 0.005</rateGaussianNoise>'
                        '<headingDrift>0.005</headingDrift><headingGaussianNoise>0.005</headingGaussianNoise></plugin>')
     st = imu.hector_settings(el, 0, "p", "imu_controller", "base_footprint")
     assert (st.link, st.frame, st.topic, st.bias_topic, st.service) == (
@@ -203,7 +205,8 @@ IMU_URDF = """<robot name="box">
   <link name="imu_link"/>
   <joint name="imu_joint" type="fixed"><parent link="base_link"/><child link="imu_link"/>
     <origin xyz="0.1 0 0.05" rpy="0 0 1.5707963267948966"/></joint>
-  <link name="arm"><inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
+  <link name="arm"><inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/>
+    </inertial></link>
   <joint name="arm_joint" type="continuous"><parent link="base_link"/><child link="arm"/>
     <origin xyz="0 0 0.1"/><axis xyz="0 0 1"/></joint>
   <gazebo reference="base_link"><mu1>0</mu1><mu2>0</mu2></gazebo>

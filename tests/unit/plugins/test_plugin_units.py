@@ -1,4 +1,5 @@
-"""Config-level pieces of the plugins that need no ROS master: the skid-steer tags, controller discovery, and the model's Gazebo tag reading (both forms, bad values, dangling references)."""
+"""Config-level pieces of the plugins that need no ROS master: the skid-steer tags, controller discovery, and the
+model's Gazebo tag reading (both forms, bad values, dangling references)."""
 
 import pytest
 
@@ -14,12 +15,15 @@ JOINTS = ("left_front_joint", "left_rear_joint", "right_front_joint", "right_rea
 # ----------------------------------------------------------------------------------------------- skid steer
 
 def _four_wheels(names=JOINTS, fixed=()):
-    body = '<link name="base_link"><inertial><mass value="5"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>'
+    body = ('<link name="base_link"><inertial><mass value="5"/>'
+            '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>')
     for i, name in enumerate(names):
         kind = "fixed" if name in fixed else "continuous"
-        body += (f'<link name="w{i}"><collision><geometry><cylinder radius="0.1" length="0.05"/></geometry></collision></link>'
+        x, y = 0.2 if i % 2 == 0 else -0.2, 0.25 if i < 2 else -0.25
+        body += (f'<link name="w{i}"><collision><geometry><cylinder radius="0.1" length="0.05"/></geometry>'
+                 '</collision></link>'
                  f'<joint name="{name}" type="{kind}"><parent link="base_link"/><child link="w{i}"/>'
-                 f'<origin xyz="{0.2 if i % 2 == 0 else -0.2} {0.25 if i < 2 else -0.25} 0"/><axis xyz="0 1 0"/></joint>')
+                 f'<origin xyz="{x} {y} 0"/><axis xyz="0 1 0"/></joint>')
     return f'<robot name="skid">{body}</robot>'
 
 
@@ -148,7 +152,8 @@ def _surface_model(parse, gazebo):
 
 def test_surface_text_and_attribute_forms_mixed(parse):
     model = _surface_model(parse, '<gazebo reference="wheel"><mu1>0.5</mu1><mu2 value="0.4"/><kp value="1e6"/>'
-                                  '<kd>20</kd><minDepth>0.001</minDepth><maxVel value="0.1"/><laserRetro>100</laserRetro>'
+                                  '<kd>20</kd><minDepth>0.001</minDepth><maxVel value="0.1"/>'
+                                  '<laserRetro>100</laserRetro>'
                                   '<fdir1 value="1 0 0"/><material>Gazebo/Black</material></gazebo>'
                                   '<gazebo reference="base_link"><mu1 value="0.2"/></gazebo>')
     assert model.surface("wheel") == {"mu1": 0.5, "mu2": 0.4, "kp": 1e6, "kd": 20.0, "minDepth": 0.001,
@@ -181,7 +186,8 @@ def test_surface_value_not_a_number_is_skipped_with_one_warning(parse, tags, kep
 
 def test_gazebo_reference_naming_nothing_warns_once(parse):
     model = _surface_model(parse, '<gazebo reference="caster_{side}_1_joint"><mu1>0.1</mu1></gazebo>'
-                                  '<gazebo reference="wheel_joint"><implicitSpringDamper>1</implicitSpringDamper></gazebo>'
+                                  '<gazebo reference="wheel_joint"><implicitSpringDamper>1</implicitSpringDamper>'
+                                  '</gazebo>'
                                   '<gazebo reference="wheel"><mu1>0.1</mu1></gazebo>')
     assert len(model.warnings) == 1
     assert "caster_{side}_1_joint" in model.warnings[0] and "names no link or joint" in model.warnings[0]
@@ -189,7 +195,8 @@ def test_gazebo_reference_naming_nothing_warns_once(parse):
 
 
 @pytest.mark.parametrize("kind, name, key", [
-    ("imu", "/imu", "imu/imu"), ("imu", "/robot1/imu data", "imu/robot1/imu_data"), ("sensor", "laser-front", "sensor/laser_front"),
+    ("imu", "/imu", "imu/imu"), ("imu", "/robot1/imu data", "imu/robot1/imu_data"),
+    ("sensor", "laser-front", "sensor/laser_front"),
     ("camera", "3d cam", "camera/n3d_cam"), ("gps", "", "gps/unnamed"),
 ])
 def test_summary_keys_are_legal_ros_names(kind, name, key):

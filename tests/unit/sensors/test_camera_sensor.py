@@ -61,8 +61,8 @@ def test_intrinsics_as_gazebo():
     info = cam.intrinsics(640, 480, 1.047, hack_baseline=0.07, distortion=(0.1, 0.2, 0.3, 0.4, 0.5))
     f = 640 / (2 * math.tan(1.047 / 2))
     assert f == pytest.approx(554.3827, abs=1e-3)
-    assert info.K == pytest.approx([f, 0, 320.5, 0, f, 240.5, 0, 0, 1])
-    assert info.P == pytest.approx([f, 0, 320.5, -f * 0.07, 0, f, 240.5, 0, 0, 0, 1, 0])
+    assert pytest.approx([f, 0, 320.5, 0, f, 240.5, 0, 0, 1]) == info.K
+    assert pytest.approx([f, 0, 320.5, -f * 0.07, 0, f, 240.5, 0, 0, 0, 1, 0]) == info.P
     assert info.R == [1, 0, 0, 0, 1, 0, 0, 0, 1]
     assert info.D == [0.1, 0.2, 0.4, 0.5, 0.3] and info.distortion_model == "plumb_bob"
 

@@ -478,8 +478,7 @@ def test_ros2_ray_sensor_outputs(stub_publisher, ros, output, topic, cls):
 
 
 def test_bad_tags_raise(stub_publisher):
-    from diffbot_sim.plugins import laser
-    from diffbot_sim.plugins import range as range_plugin
+    from diffbot_sim.plugins import laser, range as range_plugin
 
     model, sensor = _plugin_robot(f'<sensor type="ray" name="lds">{RAY}<plugin name="p" '
                                   'filename="libgazebo_ros_ray_sensor.so"><output_type>sensor_msgs/Image'

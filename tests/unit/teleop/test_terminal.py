@@ -46,13 +46,11 @@ def test_raw_terminal_sets_key_mode_and_restores_exactly(pty_pair):
 def test_raw_terminal_restores_when_the_block_raises(pty_pair):
     slave = pty_pair["slave"]
     before = termios.tcgetattr(slave)
-    with pytest.raises(KeyboardInterrupt):
-        with raw_terminal(slave):
-            raise KeyboardInterrupt  # what a signal handler raising looks like to the block
+    with pytest.raises(KeyboardInterrupt), raw_terminal(slave):
+        raise KeyboardInterrupt  # what a signal handler raising looks like to the block
     assert termios.tcgetattr(slave) == before
-    with pytest.raises(ValueError):
-        with raw_terminal(slave):
-            raise ValueError("boom")
+    with pytest.raises(ValueError), raw_terminal(slave):
+        raise ValueError("boom")
     assert termios.tcgetattr(slave) == before
 
 
@@ -164,9 +162,8 @@ def test_not_a_tty_message_is_one_helpful_line():
 def test_raw_terminal_on_a_non_tty_raises_terminal_error():
     read_end, write_end = os.pipe()
     try:
-        with pytest.raises(TerminalError):
-            with raw_terminal(read_end):
-                pass
+        with pytest.raises(TerminalError), raw_terminal(read_end):
+            pass
     finally:
         os.close(read_end)
         os.close(write_end)

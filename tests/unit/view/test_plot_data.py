@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 
 rosbag = pytest.importorskip("rosbag")
-import genpy  # noqa: E402
-from geometry_msgs.msg import TransformStamped, Twist  # noqa: E402
-from nav_msgs.msg import Odometry  # noqa: E402
-from sensor_msgs.msg import LaserScan  # noqa: E402
-from tf2_msgs.msg import TFMessage  # noqa: E402
+import genpy
+from geometry_msgs.msg import TransformStamped, Twist
+from nav_msgs.msg import Odometry
+from sensor_msgs.msg import LaserScan
+from tf2_msgs.msg import TFMessage
 
-from diffbot_sim.nodes import plot_run  # noqa: E402
-from diffbot_sim.view import plot_data  # noqa: E402
+from diffbot_sim.nodes import plot_run
+from diffbot_sim.view import plot_data
 
 
 def odom(t, x, y, yaw, v, w, frame="odom", child="base_footprint"):

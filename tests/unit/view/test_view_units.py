@@ -138,7 +138,8 @@ def test_picture_analysis():
     image[10:14, 5:40] = xscreen.STATUS_OK
     assert xscreen.status_colors(image) == {"ok": 140, "warn": 0, "error": 0}
     image[20:22, 5:10] = xscreen.STATUS_ERROR
-    assert xscreen.status_colors(image)["error"] == 10 and xscreen.rows_of_color(image, xscreen.STATUS_ERROR) == [20, 21]
+    assert xscreen.status_colors(image)["error"] == 10
+    assert xscreen.rows_of_color(image, xscreen.STATUS_ERROR) == [20, 21]
     a, b = image.copy(), image.copy()
     a[40:50, 100:120] = (255, 216, 0)  # the robot
     a[90, 5] = (255, 216, 0)  # a stray pixel far away

@@ -43,7 +43,7 @@ def write_pgm(path, pixels, maxval=255, binary=True, comment=True):
 def write_yaml(path, image="map.pgm", resolution=0.1, origin=(0.0, 0.0, 0.0), negate=0, occ=0.65, free=0.196,
                extra="", drop=()):
     """A map YAML; ``drop`` leaves keys out, ``extra`` is appended verbatim."""
-    values = {"image": image, "resolution": resolution, "origin": "[%r, %r, %r]" % tuple(origin),
+    values = {"image": image, "resolution": resolution, "origin": "[{!r}, {!r}, {!r}]".format(*tuple(origin)),
               "negate": negate, "occupied_thresh": occ, "free_thresh": free}
     with open(path, "w") as stream:
         for key, value in values.items():
