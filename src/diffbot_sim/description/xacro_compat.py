@@ -17,7 +17,14 @@ The patches (``apply()`` makes them once per process; a second call changes noth
    ``k:=${a * 2}``), where 1.13.3 splits at the first space and reports ``Undefined parameters``;
 4. ``eval_extension``: ``$(dirname)``, the directory of the file being processed (roslaunch resolves it
    only when told the file, and 1.13.3 never tells it); and ``<xacro:arg default="${2 * r}"/>``, whose
-   typed value 1.13.3 stores and roslaunch's ``$(arg)`` then fails on (noetic stores the text).
+   typed value 1.13.3 stores and roslaunch's ``$(arg)`` then fails on (noetic stores the text);
+5. ``grab_property``: the property attributes of xacro 1.13.14 / 1.14.10: ``lazy_eval="false"`` (the value
+   evaluated where it is defined, so ``<xacro:property name="p" value="${p}_" lazy_eval="false"/>`` extends
+   the old value, where a lazy one refers to itself: "recursive variable definition"), ``remove="true"``,
+   and a name computed by an expression (``name="${n}"``);
+6. ``process_include``: ``<xacro:include optional="true">`` (1.14.1) skips a file that does not exist;
+7. ``Table._eval_literal``: a value with an underscore stays text, as in noetic (Python 3 reads ``1_0`` as
+   the number 10; noetic 1.14.4 keeps such values as strings).
 
 This module imports no rospy and no xacro at import time; ``apply()`` imports xacro.
 """
@@ -36,7 +43,8 @@ SUPPORTED_SERIES = "1.13."
 #: Module attributes of xacro 1.13.x that the patches read or replace. Checked before patching.
 _HOOKS = ("global_symbols", "load_yaml", "parse_macro_arg", "eval_extension", "abs_filename_spec",
           "push_file", "restore_filestack", "filestack", "all_includes", "substitution_args_context",
-          "print_location",
+          "print_location", "grab_property", "process_include", "check_attrs", "is_valid_name",
+          "remove_previous_comments", "replace_node", "eval_text", "get_boolean_value", "Table",
           "XacroException", "message", "warning", "error", "main")
 
 #: Set on the xacro module once patched, so ``apply()`` is idempotent.
@@ -229,6 +237,99 @@ def _make_eval_extension(xacro, original):
     return eval_extension
 
 
+def _flag(xacro, text, table, default):
+    """A property or include attribute read as a boolean (``true``, ``1``, ``${expr}``; None: ``default``)."""
+    if text is None:
+        return default
+    return xacro.get_boolean_value(xacro.eval_text(text, table), text)
+
+
+def _remove_property(table, name):
+    """Forget property ``name`` in ``table`` and every enclosing scope, as noetic's ``remove="true"`` does (the
+    global symbols, ``pi`` and the like, are not properties and stay)."""
+    scope = table
+    while scope is not None:
+        scope.table.pop(name, None)
+        scope.unevaluated.discard(name)
+        scope = scope.parent
+
+
+def _make_grab_property(xacro):
+    """``<xacro:property>`` as xacro 1.13.14 / 1.14.10 reads it: 1.13.3's ``value``, ``default``, ``scope``
+    and blocks, plus ``lazy_eval``, ``remove`` and a name that is an expression."""
+
+    def grab_property(elt, table):
+        xacro.remove_previous_comments(elt)
+        name, value, default, remove, scope, lazy = xacro.check_attrs(
+            elt, ["name"], ["value", "default", "remove", "scope", "lazy_eval"])
+        name = str(xacro.eval_text(name, table))
+        if not xacro.is_valid_name(name):
+            raise xacro.XacroException("Property names must be valid python identifiers: " + name)
+        remove = _flag(xacro, remove, table, False)
+        if sum((value is not None, default is not None, remove)) > 1:
+            raise xacro.XacroException(f"property '{name}': value, default and remove exclude each other")
+        if remove:
+            _remove_property(table, name)
+            xacro.replace_node(elt, by=None)
+            return
+        if default is not None:
+            if scope is not None:
+                xacro.warning(f"{name}: default property value can only be defined on local scope")
+            if name in table:
+                xacro.replace_node(elt, by=None)
+                return
+            value = default
+        if value is None:  # a block property: the element itself
+            name, value = "**" + name, elt
+        xacro.replace_node(elt, by=None)
+        lazy = _flag(xacro, lazy, table, True)
+        if scope == "global":
+            target, lazy = table.root(), False
+        elif scope == "parent":
+            if table.parent is None:
+                xacro.warning(f"{name}: no parent scope at global scope ")
+                return
+            target, lazy = table.parent, False
+        else:
+            target = table
+        if not lazy and isinstance(value, str):
+            value = xacro.eval_text(value, table)  # now, in the scope where it is defined
+        target._setitem(name, value, unevaluated=lazy)
+
+    return grab_property
+
+
+def _make_process_include(xacro, original):
+    """1.13.3's include, and noetic's ``optional="true"``: a file that does not exist is left out."""
+
+    def process_include(elt, macros, symbols, func):
+        if elt.hasAttribute("optional"):
+            optional = _flag(xacro, elt.getAttribute("optional"), symbols, False)
+            elt.removeAttribute("optional")  # 1.13.3 would warn about an unknown attribute
+            if optional:
+                spec = xacro.abs_filename_spec(str(xacro.eval_text(elt.getAttribute("filename"), symbols)))
+                if not re.search(r"[*[?]", spec) and not os.path.isfile(spec):
+                    xacro.remove_previous_comments(elt)
+                    xacro.replace_node(elt, by=None)
+                    return
+        original(elt, macros, symbols, func)
+
+    process_include.wrapped = original
+    return process_include
+
+
+def _make_eval_literal(original):
+    """Noetic's literal reading: a value with an underscore is text (``1_0`` is not 10, ``arm_1`` stays)."""
+
+    def eval_literal(value):
+        if isinstance(value, str) and "_" in value and not (len(value) >= 2 and value[0] == value[-1] == "'"):
+            return value
+        return original(value)
+
+    eval_literal.wrapped = original
+    return staticmethod(eval_literal)
+
+
 def _xacro_namespace(xacro, load_yaml):
     """The ``xacro.`` namespace: YAML, file names, arguments and messages from inside expressions."""
 
@@ -310,6 +411,9 @@ def apply():
     xacro.load_yaml = load_yaml
     xacro.parse_macro_arg = parse_macro_arg
     xacro.eval_extension = _make_eval_extension(xacro, xacro.eval_extension)
+    xacro.grab_property = _make_grab_property(xacro)
+    xacro.process_include = _make_process_include(xacro, xacro.process_include)
+    xacro.Table._eval_literal = _make_eval_literal(xacro.Table._eval_literal)
     setattr(xacro, _MARK, True)
     return xacro
 

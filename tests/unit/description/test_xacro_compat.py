@@ -340,6 +340,102 @@ def test_parse_macro_arg(spec, expected):
     assert xacro_compat.parse_macro_arg(spec) == expected
 
 
+# --- property attributes of xacro 1.13.14 / 1.14.10 (1.13.3: "recursive variable definition") --------------
+
+
+def test_greedy_properties_as_franka_description_uses_them(run):
+    result = run(os.path.join(DATA, "greedy_arm.urdf.xacro"), {"arm_id": "fr3"})
+    robot = ET.fromstring(ok(result))
+    assert "unknown attribute" not in result.err
+    assert [link.get("name") for link in robot.iter("link")] == ["world", "fr3_link0", "fr3_link1"]
+    masses = {link.get("name"): link.find("inertial/mass").get("value") for link in robot.iter("link")
+              if link.find("inertial") is not None}
+    assert masses == {"fr3_link0": "0.63", "fr3_link1": "4.97"}
+    assert robot.find("link[@name='fr3_link1']/inertial/inertia").get("iyz") == "0.0191"
+    assert robot.find("link[@name='fr3_link0']/inertial/origin").get("xyz") == "-0.041 0 0.05"
+    limit = robot.find("joint[@name='fr3_joint1']/limit")
+    assert (limit.get("lower"), limit.get("effort"), limit.get("velocity")) == ("-2.8973", "87", "2.175")
+
+
+def test_lazy_properties_stay_lazy(run, tmp_path):
+    path = write(tmp_path, "r.xacro", """\
+        <xacro:property name="late" value="${later * 2}"/>
+        <xacro:property name="eager" value="${1 + 1}" lazy_eval="${not False}"/>
+        <xacro:property name="later" value="3"/>
+        <v n="late" x="${late}"/><v n="eager" x="${eager}"/>""")
+    assert values(ok(run(path))) == {"late": "6", "eager": "2"}
+    path = write(tmp_path, "self.xacro", """\
+        <xacro:property name="p" value="a"/><xacro:property name="p" value="${p}_b"/><v n="p" x="${p}"/>""")
+    result = run(path)
+    assert not result.ok and "recursive variable definition: p -> p" in result.err
+
+
+def test_greedy_property_is_evaluated_where_it_is_defined(run, tmp_path):
+    path = write(tmp_path, "r.xacro", """\
+        <xacro:property name="n" value="1"/>
+        <xacro:property name="snapshot" value="${n * 10}" lazy_eval="false"/>
+        <xacro:property name="lazy" value="${n * 10}"/>
+        <xacro:property name="n" value="2"/>
+        <xacro:property name="name" value="Panda"/>
+        <xacro:property name="name" value="${name.lower()}" lazy_eval="false"/>
+        <v n="snapshot" x="${snapshot}"/><v n="lazy" x="${lazy}"/><v n="name" x="${name}"/>""")
+    assert values(ok(run(path))) == {"snapshot": "10", "lazy": "20", "name": "panda"}
+    result = run(write(tmp_path, "undefined.xacro", """\
+        <xacro:property name="p" value="${nowhere}" lazy_eval="false"/>"""))
+    assert not result.ok and "nowhere" in result.err
+
+
+def test_property_remove(run, tmp_path):
+    path = write(tmp_path, "r.xacro", """\
+        <xacro:property name="gone" value="1"/>
+        <xacro:property name="kept" value="2"/>
+        <xacro:macro name="forget"><xacro:property name="gone" remove="true"/></xacro:macro>
+        <xacro:forget/>
+        <xacro:property name="gone" default="defined again: it was removed"/>
+        <v n="kept" x="${kept}"/><v n="gone" x="${gone}"/>
+        <xacro:property name="never_defined" remove="true"/>""")
+    assert values(ok(run(path))) == {"kept": "2", "gone": "defined again: it was removed"}
+    path = write(tmp_path, "use.xacro", """\
+        <xacro:property name="gone" value="1"/><xacro:property name="gone" remove="true"/><v n="g" x="${gone}"/>""")
+    result = run(path)
+    assert not result.ok and "gone" in result.err
+    path = write(tmp_path, "both.xacro", '<xacro:property name="p" value="1" remove="true"/>')
+    result = run(path)
+    assert not result.ok and "exclude each other" in result.err
+
+
+def test_property_name_from_an_expression(run, tmp_path):
+    # xacro 1.13.14's changelog example: a macro as a function that sets a property of its caller
+    path = write(tmp_path, "r.xacro", """\
+        <xacro:macro name="square" params="name args">
+          <xacro:property name="${name}" value="${[float(x)**2 for x in args]}" scope="parent"/>
+        </xacro:macro>
+        <xacro:square name="result" args="${python.range(4)}"/>
+        <v n="result" x="${result}"/>""")
+    assert values(ok(run(path))) == {"result": "[0.0, 1.0, 4.0, 9.0]"}
+
+
+def test_underscored_values_stay_text_as_in_noetic(run, tmp_path):
+    path = write(tmp_path, "r.xacro", """\
+        <xacro:property name="serial" value="1_0"/><xacro:property name="ten" value="10"/>
+        <v n="serial" x="${serial + 'x'}"/><v n="ten" x="${ten + 1}"/><v n="quoted" x="${'a_1'}"/>""")
+    assert values(ok(run(path))) == {"serial": "1_0x", "ten": "11", "quoted": "a_1"}
+
+
+def test_optional_include(run, tmp_path):
+    write(tmp_path, "parts/present.xacro", '<v n="present" x="1"/>')
+    path = write(tmp_path, "r.xacro", """\
+        <xacro:property name="dir" value="parts"/>
+        <xacro:include filename="${dir}/missing.xacro" optional="true"/>
+        <xacro:include filename="${dir}/present.xacro" optional="true"/>
+        <v n="after" x="1"/>""")
+    result = run(path)
+    assert values(ok(result)) == {"present": "1", "after": "1"} and "unknown attribute" not in result.err
+    for flag in ("", ' optional="false"'):
+        result = run(write(tmp_path, "strict.xacro", f'<xacro:include filename="parts/missing.xacro"{flag}/>'))
+        assert not result.ok and "missing.xacro" in result.err
+
+
 # --- features 1.13.3 already has (kept working) -----------------------------------------------------------
 
 
