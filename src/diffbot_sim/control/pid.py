@@ -204,9 +204,12 @@ def explicit_loop_margin(gains: PidGains, dt, inertia, loop):
     * a velocity loop (``loop`` "velocity": force = P (v* - v)) is stable while ``b = P dt / I < 2``;
     * a position loop (``loop`` "position": force = P e + D de/dt) has the characteristic polynomial
       ``z^2 - (2 - a - b) z + (1 - b)`` with ``a = P dt^2 / I`` and ``b = D dt / I``: stable while
-      ``b < 2`` and ``a + 2 b < 4``.
+      ``b < 2`` and ``a + 2 b < 4``. Without a damping term (``D = 0``, a P-only effort gain) both roots lie
+      on the unit circle whatever ``a``: nothing damps the loop but friction and the joint's limits, so it is
+      never rated stable (at least 1).
 
-    Returns the larger ratio of a quantity to its bound (inf for a non-positive inertia).
+    ``inertia`` is what the joint really moves (``Robot.joint_inertias``: the whole chain beyond it, with a
+    free base's freedom). Returns the larger ratio of a quantity to its bound (inf for a non-positive inertia).
     """
     if inertia <= 0:
         return math.inf
@@ -214,4 +217,14 @@ def explicit_loop_margin(gains: PidGains, dt, inertia, loop):
         return abs(gains.p) * dt / inertia / 2.0
     a = abs(gains.p) * dt * dt / inertia
     b = abs(gains.d) * dt / inertia
-    return max(b / 2.0, (a + 2.0 * b) / 4.0)
+    margin = max(b / 2.0, (a + 2.0 * b) / 4.0)
+    return max(margin, 1.0) if gains.d == 0 and gains.p != 0 else margin
+
+
+def loop_verdict(gains: PidGains, margin, loop):
+    """The words a warning uses for an explicit loop that is not well damped: "an undamped" (a position loop
+    without a damping term), "an unstable" (beyond its bound) or "a ringing" (stable, but over
+    STABILITY_MARGIN)."""
+    if loop == "position" and gains.d == 0 and gains.p != 0:
+        return "an undamped"
+    return "an unstable" if margin >= 1 else "a ringing"

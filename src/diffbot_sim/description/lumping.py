@@ -19,6 +19,12 @@ without ``<inertial>`` counts as 1 kg. So we lump ourselves, before PyBullet see
   ``chassis_link``) takes its fixed children like any link: Gazebo makes them one body. Kept apart, a 1e-6 kg
   PyBullet base carried the robot's mass through fixed joints, and the wheels hung on that base.
 
+* a robot joined to the world (a URDF ``world`` link, :data:`~diffbot_sim.description.urdf_model.WORLD_LINK`)
+  is never lumped into it, as sdformat lumps nothing into the world: with one fixed joint from ``world`` the
+  world link and that joint are left out (the root given is its child, which PyBullet then holds fixed);
+  otherwise ``world`` is the root, a massless stand-in PyBullet holds fixed, whose children each stay a link
+  of their own.
+
 Measured with 10 fixed sensor links: lumping keeps PyBullet's step rate (no extra links), where loading
 them unmerged costs ~25 %.
 """
@@ -29,7 +35,8 @@ from typing import Dict, List, Tuple
 
 import numpy as np
 
-from diffbot_sim.transforms import rpy_matrix
+from diffbot_sim.description.urdf_model import WORLD_LINK
+from diffbot_sim.transforms import matrix_rpy, rpy_matrix
 
 #: Mass [kg] of a root link left without any: PyBullet treats a base of mass 0 as fixed in the world.
 ROOT_PLACEHOLDER_MASS = 1e-6
@@ -51,20 +58,6 @@ class LumpedUrdf:
     frames: Dict[str, Tuple[str, Tuple[float, float, float], Tuple[float, float, float, float]]]
     lumped: List[str] = field(default_factory=list)  # links merged into another
     placeholders: List[str] = field(default_factory=list)  # links given a placeholder mass
-
-
-def matrix_rpy(m):
-    """Inverse of :func:`rpy_matrix` (roll, pitch, yaw), robust at pitch = +-pi/2."""
-    sp = -m[2, 0]
-    if abs(sp) >= 1.0 - 1e-12:
-        pitch = math.copysign(math.pi / 2, sp)
-        roll = 0.0
-        yaw = math.atan2(-m[0, 1], m[1, 1])
-    else:
-        pitch = math.asin(sp)
-        roll = math.atan2(m[2, 1], m[2, 2])
-        yaw = math.atan2(m[1, 0], m[0, 0])
-    return roll, pitch, yaw
 
 
 def matrix_quaternion(m):
@@ -186,7 +179,8 @@ def lump(urdf_text, root_link, surface):
 
     Args:
         urdf_text: the URDF (mesh paths already resolved).
-        root_link: the model's root link name.
+        root_link: the model's root link name (RobotModel.root); links and joints not below it (the ``world``
+            link and its joint of a robot held by one fixed joint to the world) are left out.
         surface: ``surface(link) -> dict`` of the link's Gazebo surface tags (RobotModel.surface).
 
     Returns:
@@ -219,7 +213,8 @@ def lump(urdf_text, root_link, surface):
             t = offset[name] @ origin_matrix(joint)
             carrier = body[name]
             has_collision = links[child].find("collision") is not None
-            if joint.get("type") == "fixed" and (not has_collision or key(child) == key(carrier)):
+            if (joint.get("type") == "fixed" and name != WORLD_LINK
+                    and (not has_collision or key(child) == key(carrier))):
                 body[child], offset[child] = carrier, t
                 lumped.append(child)
             else:
@@ -232,6 +227,13 @@ def lump(urdf_text, root_link, surface):
         part = _transform_inertial(read_inertial(links[name]), offset[name])
         parts.setdefault(body[name], []).append(part)
 
+    for name, el in links.items():
+        if name not in body:  # above the root: the world link of a robot fixed to the world
+            root.remove(el)
+    for joint in list(joints):
+        if joint.find("parent").get("link") not in body:
+            root.remove(joint)
+            joints.remove(joint)
     for name in lumped:
         el, carrier = links[name], links[body[name]]
         for tag in ("visual", "collision"):

@@ -25,6 +25,11 @@ def tag_value(element):
     return text
 
 
+#: The link name by which a URDF joins a robot to the world: sdformat's URDF reader models no link of that name
+#: but turns each joint from it into a joint between the model and the world (the model is held where it is
+#: spawned), and never lumps a link into it (the first real link keeps its name).
+WORLD_LINK = "world"
+
 #: Joint interfaces a transmission may declare (ros_control's, without the ``hardware_interface/`` prefix).
 JOINT_INTERFACES = ("VelocityJointInterface", "EffortJointInterface", "PositionJointInterface")
 
@@ -145,9 +150,38 @@ class RobotModel:
     joints: Dict[str, Joint]
     transmissions: List[Transmission]
     gazebo: List[GazeboBlock]
+    #: The model's canonical link, the one /gazebo names first and PyBullet's base: the URDF's root link; for a
+    #: robot joined to the world by one fixed joint from ``world``, that joint's child; ``world`` itself (a
+    #: massless stand-in for the world, fixed) when it is joined by a movable joint or by several.
     root: str
+    #: The joints from ``world`` (WORLD_LINK): each holds the robot to the world as Gazebo's joint to the world
+    #: does (the model's base is fixed where it is spawned). Empty for a free robot.
+    world_joints: List[Joint] = field(default_factory=list)
     warnings: List[str] = field(default_factory=list)  # published mistakes survived, one line each
     _surfaces: Dict[str, dict] = field(default_factory=dict, repr=False)
+
+    @property
+    def fixed_to_world(self):
+        """The robot is joined to the world (a URDF ``world`` link), so its base never moves."""
+        return bool(self.world_joints)
+
+    @property
+    def anchor(self):
+        """The one fixed joint from ``world`` whose child is the root (the world link then is not loaded), or
+        None: a free robot, or one whose root is the ``world`` stand-in itself."""
+        if len(self.world_joints) == 1 and self.world_joints[0].type == "fixed" and self.root != WORLD_LINK:
+            return self.world_joints[0]
+        return None
+
+    def gazebo_links(self):
+        """The links Gazebo keeps, canonical first: the root (never the ``world`` stand-in), every child of a
+        joint from the world, and every child of a moving joint (fixed-joint children are lumped into their
+        parent). Lumped links still have poses (``Robot.link_motion``)."""
+        out = [] if self.root == WORLD_LINK else [self.root]
+        for joint in self.joints.values():
+            if (joint.type != "fixed" or joint.parent == WORLD_LINK) and joint.child not in out:
+                out.append(joint.child)
+        return out
 
     def joint(self, name, referrer):
         """Return joint ``name`` or raise ModelError naming ``referrer`` (the element that asked for it)."""
@@ -278,7 +312,11 @@ def parse_urdf(text, source="robot_description"):
     if len(roots) != 1:
         raise ModelError(f"must have exactly one root link, found {len(roots)}: {', '.join(roots)}", source, "/robot")
 
-    model = RobotModel(name, source, links, joints, [], [], roots[0])
+    world_joints = [j for j in joints.values() if j.parent == WORLD_LINK] if roots[0] == WORLD_LINK else []
+    canonical = roots[0]
+    if len(world_joints) == 1 and world_joints[0].type == "fixed":
+        canonical = world_joints[0].child  # the world link itself is not loaded (WORLD_LINK)
+    model = RobotModel(name, source, links, joints, [], [], canonical, world_joints)
     for index, el in enumerate(root.findall("transmission"), start=1):
         model.transmissions.append(_transmission(el, index, model))
     for index, el in enumerate(root.findall("gazebo"), start=1):

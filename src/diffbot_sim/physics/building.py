@@ -15,7 +15,9 @@ def load_robot_body(client, urdf_text, model, position, orientation, files):
     URDF PyBullet reads is a temporary file, appended to ``files`` (the caller removes them when it closes).
 
     Fixed links are lumped as Gazebo lumps them (:mod:`diffbot_sim.description.lumping`), not by PyBullet's
-    URDF_MERGE_FIXED_LINKS, which would give inertia-less links 1 kg and a merged body one friction.
+    URDF_MERGE_FIXED_LINKS, which would give inertia-less links 1 kg and a merged body one friction. A robot
+    joined to the world (``model.fixed_to_world``) gets a fixed base: PyBullet holds its root where it is
+    placed, as Gazebo's joint to the world holds the model (gravity and contacts never move it).
 
     Raises:
         ModelError: PyBullet could not load it (the model's file named).
@@ -27,7 +29,8 @@ def load_robot_body(client, urdf_text, model, position, orientation, files):
     files.append(path)
     flags = pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_USE_IMPLICIT_CYLINDER
     with quiet(1):
-        body = pybullet.loadURDF(path, position, orientation, flags=flags, physicsClientId=client)
+        body = pybullet.loadURDF(path, position, orientation, useFixedBase=model.fixed_to_world, flags=flags,
+                                 physicsClientId=client)
     if body < 0:
         raise ModelError("PyBullet could not load the model", model.source)
     return body, prepared.frames

@@ -52,7 +52,12 @@ class Landings:
         Bullet would push it out in one step and throw it (measured: a robot 6 cm deep left at 14 m/s, one
         13 cm deep flew 18 m up). Only contacts whose surface faces up count (a normal within 60 degrees of
         +z): a robot is lifted off what it stands in, never pushed sideways out of a wall.
+
+        A robot joined to the world is left where it is (0.0): Gazebo neither lifts nor sets down a model
+        its joint to the world holds, and PyBullet holds its base.
         """
+        if robot.model.fixed_to_world:
+            return 0.0
         robot.damp_contacts(True)
         self._landing[robot] = [0, round(LANDING_MAX_TIME / self.time_step)]
         c = self.client

@@ -11,12 +11,13 @@ from diffbot_sim.physics.world import LANDING_MAX_TIME
 def place_robot(world, prepared, x, y, z=0.0, yaw=0.0):
     """Load ``prepared`` with its root link at (``x``, ``y``) [m], turned by ``yaw`` [rad], raised onto the
     world: at the top of the highest world surface under (x, y) when that is above ``z`` (a robot spawned over
-    a table stands on it), else at ``z``. Returns the physics Robot.
+    a table stands on it), else at ``z``. A robot joined to the world stays at ``z``: Gazebo holds it where it is
+    spawned. Returns the physics Robot.
 
     Raises:
         ModelError: PyBullet could not load the model.
     """
-    if world.world_bodies:
+    if world.world_bodies and not prepared.model.fixed_to_world:
         z = max(z, world.top_at(x, y))
     return world.load_robot(prepared.text, prepared.model, (x, y, z), yaw)
 

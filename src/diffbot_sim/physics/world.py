@@ -79,12 +79,19 @@ class World:
     # -- building: robots, the world's bodies, actors' boxes -------------------------------------------------
     def load_robot(self, urdf_text, model, position=(0.0, 0.0, 0.0), yaw=0.0, orientation=None):
         """Load a robot and set it down; returns a Robot. ``model`` is the parsed RobotModel of the same text. The
-        root link frame is placed at ``position`` turned by ``yaw``, or by the quaternion ``orientation`` when
-        given. Fixed links are lumped as Gazebo lumps them (:func:`building.load_robot_body`)."""
+        model frame is placed at ``position`` turned by ``yaw``, or by the quaternion ``orientation`` when given:
+        a free robot's root link frame is the model frame; a robot joined to the world by a fixed joint has its
+        root where that joint's origin puts it in the model frame, held there (no landing: Gazebo does not set
+        such a model down either). Fixed links are lumped as Gazebo lumps them (:func:`building.load_robot_body`)."""
         if orientation is None:
             orientation = pybullet.getQuaternionFromEuler((0.0, 0.0, yaw))
-        body, frames = building.load_robot_body(self.client, urdf_text, model, position, orientation, self._files)
-        robot = Robot(self.client, body, model, position, orientation, frames, self.time_step, self.landing.erp)
+        root_pose = (position, orientation)
+        if model.anchor is not None:
+            joint = model.anchor
+            root_pose = pybullet.multiplyTransforms(position, orientation, joint.xyz,
+                                                    pybullet.getQuaternionFromEuler(joint.rpy))
+        body, frames = building.load_robot_body(self.client, urdf_text, model, *root_pose, self._files)
+        robot = Robot(self.client, body, model, *root_pose, frames, self.time_step, self.landing.erp)
         robot.gravity = self.gravity
         self.robots.append(robot)
         self.lift_out(robot)

@@ -13,7 +13,7 @@ draws from the master alone.
 import math
 
 from diffbot_sim.control.mimic_joint import MimicCore, mimic_config, urdf_mimic_target
-from diffbot_sim.control.pid import STABILITY_MARGIN, explicit_loop_margin, pid_gains
+from diffbot_sim.control.pid import STABILITY_MARGIN, explicit_loop_margin, loop_verdict, pid_gains
 from diffbot_sim.errors import PluginNotLoaded
 from diffbot_sim.plugins.base import Plugin, get_param
 from diffbot_sim.plugins.joint_motors import UNLIMITED_EFFORT
@@ -37,7 +37,7 @@ class MimicJoint(Plugin):
             if margin > STABILITY_MARGIN:
                 ctx.warnings.append(
                     f"{cfg.path}: the PID at {cfg.pid_namespace} (p={gains.p:g}, d={gains.d:g}) is "
-                    f"{'an unstable' if margin >= 1 else 'a ringing'} explicit loop at a "
+                    f"{loop_verdict(gains, margin, 'position')} explicit loop at a "
                     f"{ctx.cfg.time_step * 1000:.2f} ms step on {cfg.mimic_joint} (it moves {inertia:.3g}); "
                     f"it runs as PyBullet's position motor capped at maxEffort {abs(cfg.max_effort):g} instead")
                 self.motor, self.force = True, abs(cfg.max_effort) if cfg.max_effort else UNLIMITED_EFFORT

@@ -4,12 +4,15 @@ Each answers ``links()``, ``motion(link)`` ((pose, linear, angular) in world axe
 ``link`` None), ``set_motion(pose, linear, angular, link)`` and ``body_of(link)`` (the PyBullet body and link a
 wrench pushes).
 """
+import rospy
+
 from diffbot_sim.gazebo.world_api import RequestError
-from diffbot_sim.transforms import compose, inverse
+from diffbot_sim.transforms import compose, inverse, rpy_quaternion
 
 
 class RobotModelEntity:
-    """A robot as a Gazebo model: its root link is the model frame."""
+    """A robot as a Gazebo model: its root link is the model frame (for a robot joined to the world by a fixed
+    joint, the model frame is where the spawn put it and the root sits at that joint's origin in it)."""
 
     static = False
 
@@ -18,20 +21,35 @@ class RobotModelEntity:
         self.name = runtime.name
         self.robot = runtime.ctx.robot
         self.model = runtime.ctx.model
+        self._warned_fixed = False
 
     def links(self):
-        """The links Gazebo keeps: the root and every child of a moving joint (fixed-joint children are
-        lumped into their parent, as Gazebo's URDF reader does); lumped links still answer ``motion``."""
-        return [self.model.root] + [j.child for j in self.model.joints.values() if j.type != "fixed"]
+        """The links Gazebo keeps (``RobotModel.gazebo_links``: the root, the children of joints to the world
+        and of moving joints; fixed-joint children are lumped into their parent, as Gazebo's URDF reader does);
+        lumped links still answer ``motion``."""
+        return self.model.gazebo_links()
 
     def motion(self, link=None):
-        """(pose, linear, angular) of a link frame (the root: the model), world axes."""
-        return self.robot.link_motion(link or self.model.root)
+        """(pose, linear, angular) of a link frame (none: the model frame), world axes."""
+        pose, linear, angular = self.robot.link_motion(link or self.model.root)
+        anchor = self.model.anchor
+        if link is None and anchor is not None:  # the model frame: the root's pose less its joint to the world
+            pose = compose(pose, inverse((anchor.xyz, rpy_quaternion(*anchor.rpy))))
+        return pose, linear, angular
 
     def set_motion(self, pose, linear, angular, link=None):
         if link not in (None, self.model.root):
             raise RequestError(f"link '{self.name}::{link}' is not the model's canonical link "
                                f"'{self.model.root}': only a whole model can be moved here")
+        if self.model.fixed_to_world:
+            # Gazebo's fixed joint to the world keeps the relative pose it was attached with (ODE's
+            # dJointSetFixed at load) and pulls a teleported model straight back: it stays where spawned.
+            if not self._warned_fixed:
+                self._warned_fixed = True
+                joints = ", ".join(j.name for j in self.model.world_joints)
+                rospy.logwarn(f"model '{self.name}' is joined to the world ({joints}): a new pose for it does not "
+                              "move it; its joint to the world holds it where it was spawned, as in Gazebo")
+            return
         self.robot.set_base_motion(pose, linear, angular)
         self.runtime.ctx.sim.world.lift_out(self.robot)
 

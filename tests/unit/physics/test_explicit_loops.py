@@ -5,7 +5,7 @@ import math
 
 import pytest
 
-from diffbot_sim.control.pid import STABILITY_MARGIN, Pid, PidGains, explicit_loop_margin
+from diffbot_sim.control.pid import STABILITY_MARGIN, Pid, PidGains, explicit_loop_margin, loop_verdict
 from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.physics import World
 
@@ -65,11 +65,20 @@ def test_gazebo_tuned_velocity_gain_is_unstable_at_our_step():
 
 
 def test_joint_inertias_are_what_the_motor_moves():
-    """The mass matrix's diagonal: the wheel's own Iyy; the arm link's Iyy plus m r^2 about the shoulder."""
-    _, wheel = run(WHEEL, "axle", lambda *a: None, seconds=DT)
-    _, arm = run(ARM, "shoulder", lambda *a: None, seconds=DT)
-    assert wheel == pytest.approx(0.01, rel=1e-6)
+    """On an arm fixed to the world: the link's Iyy plus m r^2 about the shoulder (the mass matrix's diagonal).
+    On a free base: less, by what the base turns back (the Schur complement): a wheel turning about an axle
+    through both centres of mass moves Iw Ib / (Iw + Ib), not Iw."""
+    fixed_arm = ARM.replace('<robot name="one_link_arm">', '<robot name="one_link_arm"><link name="world"/>'
+                            '<joint name="bolt" type="fixed"><parent link="world"/><child link="base"/></joint>')
+    _, arm = run(fixed_arm, "shoulder", lambda *a: None, seconds=DT)
     assert arm == pytest.approx(1e-4 + 0.1 * 0.05 ** 2, rel=1e-6)
+    free_wheel = WHEEL.replace('<origin xyz="0 0 1"/>', '<origin xyz="0 0 0"/>')
+    _, wheel = run(free_wheel, "axle", lambda *a: None, seconds=DT)
+    assert wheel == pytest.approx(0.01 * 1.0 / (0.01 + 1.0), rel=1e-6)
+    light_base = free_wheel.replace('<mass value="100"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"',
+                                    '<mass value="4"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"')
+    _, wheel = run(light_base, "axle", lambda *a: None, seconds=DT)
+    assert wheel == pytest.approx(0.005, rel=1e-6)  # half the diagonal: the base spins back as much
 
 
 def position_pid(gains, target, limit=5.0):
@@ -97,3 +106,17 @@ def test_implicit_position_motor_holds_the_target_under_gravity():
     history, _ = run(ARM, "shoulder", motor, gravity=-9.81)
     assert history[-1][0] == pytest.approx(0.5, abs=0.01)
     assert abs(history[-1][1]) < 0.01
+
+
+def test_a_loop_without_damping_is_never_rated_stable():
+    """P-only (no d term, as published effort trajectory gains may be): however small p is against the joint's
+    inertia, the explicit loop keeps ringing (nothing damps it but friction), so it is never rated well damped
+    (the a + 2b < 4 bound alone would call p = 2 on this link 0.025 of its bound)."""
+    undamped = PidGains(2.0)
+    history, inertia = run(ARM, "shoulder", position_pid(undamped, 0.5), seconds=6.0)
+    assert (undamped.p * DT * DT / inertia) / 4.0 < 0.05  # the bound alone: "well damped"
+    assert explicit_loop_margin(undamped, DT, inertia, "position") >= 1.0
+    tail = [p for p, _ in history[-240:]]
+    assert max(tail) - min(tail) > 0.3  # still swinging about 0.5 rad, +-0.24 rad after 5 s
+    assert loop_verdict(undamped, explicit_loop_margin(undamped, DT, inertia, "position"), "position") == \
+        "an undamped"

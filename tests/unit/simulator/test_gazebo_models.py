@@ -5,6 +5,7 @@ from types import SimpleNamespace
 
 import pytest
 
+from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.gazebo.world_api import RequestError
 from diffbot_sim.simulator.gazebo_models import (
     ActorModelEntity,
@@ -139,9 +140,19 @@ def test_a_world_model_is_static_only_when_every_link_is():
 
 # -- a robot ---------------------------------------------------------------------------------------------------
 
-class Joint:
-    def __init__(self, child, kind):
-        self.child, self.type = child, kind
+ROBOT_URDF = """<robot name="robot1">
+  <link name="base_link"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/>
+    </inertial></link>
+  <link name="wheel"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/>
+    </inertial></link>
+  <link name="laser"/>
+  <joint name="wheel_joint" type="continuous"><parent link="base_link"/><child link="wheel"/></joint>
+  <joint name="laser_joint" type="fixed"><parent link="base_link"/><child link="laser"/></joint>
+</robot>"""
+#: the same robot bolted to the world 0.5 m up, as arm descriptions bolt theirs (a URDF link named world)
+FIXED_URDF = ROBOT_URDF.replace('<link name="laser"/>', '<link name="laser"/><link name="world"/>'
+                                '<joint name="bolt" type="fixed"><parent link="world"/><child link="base_link"/>'
+                                '<origin xyz="0 0 0.5"/></joint>')
 
 
 class FakeRobot:
@@ -172,10 +183,9 @@ class FakePhysics:
 class Runtime:
     """A RobotRuntime as the entity reads it: name, ctx.robot, ctx.model, ctx.sim.world."""
 
-    def __init__(self):
+    def __init__(self, urdf=ROBOT_URDF):
         self.name = "robot1"
-        model = SimpleNamespace(root="base_link", joints={"wheel_joint": Joint("wheel", "continuous"),
-                                                          "laser_joint": Joint("laser", "fixed")})
+        model = parse_urdf(urdf)
         self.ctx = SimpleNamespace(robot=FakeRobot(), model=model, sim=SimpleNamespace(world=FakePhysics()))
 
 
@@ -192,3 +202,16 @@ def test_a_robot_keeps_its_root_and_moving_links_and_is_moved_whole():
     with pytest.raises(RequestError, match="not the model's canonical link 'base_link'"):
         entity.set_motion(IDENTITY, ZERO, ZERO, "wheel")
     assert entity.body_of("wheel") == (3, 0)
+
+
+def test_a_robot_bolted_to_the_world_keeps_its_first_link_and_stays_where_spawned():
+    """A URDF ``world`` link is no link of the model: base_link is the canonical link (not lumped into world),
+    the model frame sits 0.5 m below it (the bolt's origin), and a new pose does not move it (Gazebo's fixed
+    joint to the world pulls it back)."""
+    runtime = Runtime(FIXED_URDF)
+    entity = RobotModelEntity(runtime)
+    assert entity.links() == ["base_link", "wheel"]
+    assert flat(entity.motion()[0]) == approx_pose(((0.0, 0.0, -0.5), (0.0, 0.0, 0.0, 1.0)))
+    assert entity.motion("base_link")[0] == IDENTITY
+    entity.set_motion(((1.0, 0.0, 0.0), YAW90), (0.5, 0.0, 0.0), ZERO)
+    assert runtime.ctx.robot.base is None and runtime.ctx.sim.world.lifted == []

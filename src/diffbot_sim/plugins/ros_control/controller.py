@@ -69,7 +69,7 @@ class Controller:
         at our step (gains tuned for Gazebo's 1 ms step on light links): each is handed to PyBullet's
         ``mode`` motor within the effort limit (or ``force``), with one warning naming it, and returned: the
         controller then writes its desired positions to them instead of efforts."""
-        from diffbot_sim.control.pid import STABILITY_MARGIN
+        from diffbot_sim.control.pid import STABILITY_MARGIN, loop_verdict
 
         out = set()
         for joint, joint_gains in zip(joints, gains):
@@ -80,7 +80,7 @@ class Controller:
                 self.hw.drive_by_targets(joint, mode, force)
                 self.ctx.warnings.append(
                     f"{self.name}: gains of {joint} (p={joint_gains.p:g}, d={joint_gains.d:g}) are "
-                    f"{'an unstable' if margin >= 1 else 'a ringing'} explicit loop at a "
+                    f"{loop_verdict(joint_gains, margin, loop)} explicit loop at a "
                     f"{self.ctx.cfg.time_step * 1000:.2f} ms step on this joint (it moves {inertia:.3g}, "
                     f"{margin:.2g} of the stability bound); the joint follows the controller's desired "
                     f"{mode} through PyBullet's motor within its effort limit instead")

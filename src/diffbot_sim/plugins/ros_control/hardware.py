@@ -30,7 +30,7 @@ from typing import Optional
 
 from diffbot_sim.control.angles import shortest_angular_distance, shortest_angular_distance_with_limits
 from diffbot_sim.control.joint_limits import JointLimitsInterfaceError, register_joint_limits
-from diffbot_sim.control.pid import STABILITY_MARGIN, Pid, explicit_loop_margin, pid_gains
+from diffbot_sim.control.pid import STABILITY_MARGIN, Pid, explicit_loop_margin, loop_verdict, pid_gains
 from diffbot_sim.errors import ConfigError
 from diffbot_sim.plugins.base import get_param, join
 from diffbot_sim.plugins.joint_motors import UNLIMITED_EFFORT
@@ -135,7 +135,7 @@ class RobotHWSim:
                 gains = joint.pid.gains
                 warnings.append(
                     f"{join(self.ns, 'gazebo_ros_control/pid_gains')}/{joint.name}: p={gains.p:g} d={gains.d:g} at a "
-                    f"{dt * 1000:.2f} ms step is {'an unstable' if margin >= 1 else 'a ringing'} explicit loop on "
+                    f"{dt * 1000:.2f} ms step is {loop_verdict(gains, margin, loop)} explicit loop on "
                     f"this joint (it moves {inertia:.3g} {'kg' if joint.joint_type == 'prismatic' else 'kg·m^2'}, "
                     f"{margin:.2g} of the stability bound); it runs as PyBullet's {loop} motor with the same "
                     f"effort limit instead")
