@@ -70,6 +70,16 @@ if [ ! -x "$VENV/bin/python" ] || [ "$(cat "$STAMP" 2>/dev/null)" != "$want_sha"
   "$VENV/bin/python" -m pip install -q --disable-pip-version-check -r "$REQ"
   echo "$want_sha" > "$STAMP"
 fi
+# The developers' and CI's tools (ruff, mypy: `make lint`), in the same venv under a stamp of their own, so that
+# STAMP still says the venv holds exactly requirements.txt's pins (an install space seeds its venv on that).
+REQ_DEV="$ROOT/requirements-dev.txt"
+DEV_STAMP="$VENV/.requirements-dev.sha"
+want_dev_sha=$(sha256sum "$REQ_DEV" | cut -d' ' -f1)
+if [ "$(cat "$DEV_STAMP" 2>/dev/null)" != "$want_dev_sha" ]; then
+  log "installing the developer tools of $(basename "$REQ_DEV") into $VENV"
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check -r "$REQ_DEV"
+  echo "$want_dev_sha" > "$DEV_STAMP"
+fi
 
 # Launch files run `xacro file.xacro`: it must be xacro 1.13.3 plus diffbot_sim.description.xacro_compat (noetic's
 # features), not pip's bare entry point. pip rewrites .venv/bin/xacro whenever it (re)installs xacro, so
