@@ -98,6 +98,37 @@ def rpy_quaternion(roll, pitch, yaw):
             cr * cp * cy + sr * sp * sy)
 
 
+def _rpy_of(r00, r10, r20, r21, r22, r11, r12):
+    """(roll, pitch, yaw) from the rotation matrix entries they need (see :func:`matrix_rpy`)."""
+    cos_pitch = math.hypot(r00, r10)
+    pitch = math.atan2(-r20, cos_pitch)
+    if cos_pitch < 1e-12:  # gimbal lock: only roll - yaw (pitch +pi/2) or roll + yaw (-pi/2) is defined
+        return math.atan2(-r12, r11), pitch, 0.0
+    return math.atan2(r21, r22), pitch, math.atan2(r10, r00)
+
+
+def matrix_rpy(m):
+    """Fixed-axis (roll, pitch, yaw) [rad] of the rotation matrix ``m`` (3 x 3, ``m[i][j]``): the inverse of
+    :func:`rpy_matrix`, as Python floats.
+
+    Pitch is read with ``atan2`` from the matrix, so it stays exact near +-pi/2 where ``asin`` would lose half
+    the digits. At gimbal lock (cos pitch < 1e-12, which also catches a matrix composed of two half pitches,
+    where rounding leaves |sin pitch| a hair above 1) yaw is 0 and roll carries the rest, as ignition-math's
+    ``Quaternion::Euler`` decides (Gazebo writes a spawned model's ``<pose>`` with it).
+    """
+    return _rpy_of(float(m[0][0]), float(m[1][0]), float(m[2][0]), float(m[2][1]), float(m[2][2]),
+                   float(m[1][1]), float(m[1][2]))
+
+
+def quaternion_rpy(q):
+    """Fixed-axis (roll, pitch, yaw) [rad] of the quaternion ``q`` (x, y, z, w; normalised first): the inverse
+    of :func:`rpy_quaternion`, read as :func:`matrix_rpy` reads the rotation matrix (the one conversion of a
+    full rotation to angles; ignition-math's convention at gimbal lock)."""
+    x, y, z, w = qnormalize(tuple(float(c) for c in q))
+    return _rpy_of(1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y), 2 * (y * z + w * x),
+                   1 - 2 * (x * x + y * y), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x))
+
+
 def roll_pitch_from_quaternion(x, y, z, w):
     """(roll, pitch) [rad] of a unit quaternion, fixed-axis x-y-z (REP 103); pitch in [-pi/2, pi/2]."""
     roll = math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))

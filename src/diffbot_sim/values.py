@@ -105,3 +105,13 @@ def check_string(name, value, allow_empty=False):
     if not isinstance(value, str) or (not allow_empty and not value.strip()):
         raise ConfigError(name, value, "a non-empty string" if not allow_empty else "a string")
     return value.strip()
+
+
+def check_mapping(name, value, expected="a dictionary"):
+    """A namespace of parameters (a dict, as the parameter server hands one out): ``value`` itself, ``{}`` when
+    it is absent (None), else ConfigError naming ``name`` and saying what was ``expected``."""
+    if value is None:
+        return {}
+    if not isinstance(value, dict):
+        raise ConfigError(name, value, expected)
+    return value

@@ -11,11 +11,13 @@ import pytest
 from diffbot_sim.transforms import (
     compose,
     inverse,
+    matrix_rpy,
     qconj,
     qmul,
     qnormalize,
     quaternion_from_yaw,
     quaternion_matrix,
+    quaternion_rpy,
     roll_pitch_from_quaternion,
     rotate,
     rpy_matrix,
@@ -129,3 +131,54 @@ def test_yaw_from_quaternion_matches_pybullet():
 def test_wrap_angle(angle, turn):
     """A heading difference as the turn it is (the tour steers by it, drive checks judge by it)."""
     assert wrap_angle(angle) == pytest.approx(turn)
+
+
+# ------------------------------------------------------------------------------------------ to angles
+
+def ign_euler(q):
+    """ignition-math6's ``Quaternion::Euler`` (6.9.2, include/ignition/math/Quaternion.hh) transcribed as the
+    reference: normalise, pitch = asin(-2 (xz - wy)) clamped; at |sin pitch -+ 1| < 1e-15 yaw is 0 and roll
+    carries the rest."""
+    n = math.sqrt(sum(c * c for c in q))
+    x, y, z, w = (c / n for c in q) if n > 1e-6 else (0.0, 0.0, 0.0, 1.0)
+    squ, sqx, sqy, sqz = w * w, x * x, y * y, z * z
+    sarg = -2 * (x * z - w * y)
+    pitch = -math.pi / 2 if sarg <= -1 else math.pi / 2 if sarg >= 1 else math.asin(sarg)
+    if abs(sarg - 1) < 1e-15:
+        return math.atan2(2 * (x * y - z * w), squ - sqx + sqy - sqz), pitch, 0.0
+    if abs(sarg + 1) < 1e-15:
+        return math.atan2(-2 * (x * y - z * w), squ - sqx + sqy - sqz), pitch, 0.0
+    return (math.atan2(2 * (y * z + w * x), squ - sqx - sqy + sqz), pitch,
+            math.atan2(2 * (x * y + w * z), squ + sqx - sqy - sqz))
+
+
+def test_quaternion_rpy_is_ignition_maths_euler():
+    rng = np.random.default_rng(7)
+    for q in rng.normal(size=(500, 4)):
+        assert near(quaternion_rpy(q), ign_euler(q), 1e-9), q
+    assert near(quaternion_rpy((0.0, 0.0, 0.0, 2.0)), (0.0, 0.0, 0.0))  # not normalised: normalised first
+
+
+@pytest.mark.parametrize("pitch", [math.pi / 2, -math.pi / 2])
+@pytest.mark.parametrize("roll, yaw", [(0.0, 0.0), (0.4, -1.0), (-2.0, 2.5)])
+def test_at_gimbal_lock_yaw_is_zero_and_roll_carries_the_rest_as_in_ignition(roll, pitch, yaw):
+    q = rpy_quaternion(roll, pitch, yaw)
+    out = quaternion_rpy(q)
+    assert out[1] == pytest.approx(pitch, abs=1e-7) and out[2] == 0.0
+    assert abs(wrap_angle(out[0] - ign_euler(q)[0])) < 1e-7
+    assert near(rpy_quaternion(*out), q, 1e-7) or near(rpy_quaternion(*out), tuple(-c for c in q), 1e-7)
+    m = rpy_matrix((roll, pitch, yaw))
+    assert matrix_rpy(m)[2] == 0.0 and np.allclose(rpy_matrix(matrix_rpy(m)), m, atol=1e-9)
+
+
+def test_pitch_stays_exact_next_to_gimbal_lock_where_asin_loses_digits():
+    pitch = math.pi / 2 - 1e-7
+    q = rpy_quaternion(0.3, pitch, -0.2)
+    assert quaternion_rpy(q)[1] == pytest.approx(pitch, abs=1e-12)
+    assert matrix_rpy(rpy_matrix((0.3, pitch, -0.2))) == pytest.approx((0.3, pitch, -0.2), abs=1e-9)
+    assert abs(ign_euler(q)[1] - pitch) > 1e-11  # why the angle is read from the matrix with atan2
+
+
+def test_matrix_rpy_returns_floats_from_a_numpy_matrix():
+    out = matrix_rpy(rpy_matrix((0.1, 0.2, 0.3)))
+    assert out == pytest.approx((0.1, 0.2, 0.3), abs=1e-12) and all(type(v) is float for v in out)

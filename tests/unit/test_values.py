@@ -5,7 +5,7 @@ import math
 import pytest
 
 from diffbot_sim.errors import ConfigError
-from diffbot_sim.values import leading_number, tag_number
+from diffbot_sim.values import check_mapping, leading_number, tag_number
 
 
 @pytest.mark.parametrize("text, value, rest", [
@@ -58,3 +58,14 @@ def test_tag_number_errors_name_the_tag_and_the_text_as_written():
 def test_values_that_are_not_text_are_only_checked():
     notes = []
     assert tag_number("<width>", 320, notes, integer=True, low=1) == 320 and notes == []
+
+
+def test_check_mapping_reads_a_namespace_of_parameters():
+    """The one check of a parameter sub-namespace: absent is empty, a dict is itself, else one line naming it."""
+    assert check_mapping("/arm/constraints", None) == {}
+    gains = {"p": 1.0}
+    assert check_mapping("/arm/gains", gains) is gains
+    with pytest.raises(ConfigError, match=r"^parameter /arm/gains: got \[1, 2\], expected a dictionary$"):
+        check_mapping("/arm/gains", [1, 2])
+    with pytest.raises(ConfigError, match=r"expected a mapping of joint name -> PID gains$"):
+        check_mapping("/gripper/gains", 3.0, "a mapping of joint name -> PID gains")

@@ -14,6 +14,7 @@ from typing import Optional, Tuple
 
 from diffbot_sim.control.limits import SpeedLimiter
 from diffbot_sim.errors import ConfigError
+from diffbot_sim.values import check_mapping
 
 CONTROLLER_TYPE = "diff_drive_controller/DiffDriveController"
 
@@ -245,14 +246,11 @@ def _covariance(name, value):
 def _axis_limits(ns, params, group, axis, unknown):
     """Read ``<group>/<axis>/*`` (e.g. ``linear/x``); other axes and keys go to ``unknown``."""
     prefix = f"{ns}/{group}"
-    block = params.get(group, {})
-    if not isinstance(block, dict):
-        raise ConfigError(prefix, block, f"a mapping such as {{{axis}: {{has_velocity_limits: true, ...}}}}")
+    block = check_mapping(prefix, params.get(group),
+                          f"a mapping such as {{{axis}: {{has_velocity_limits: true, ...}}}}")
     unknown.extend(f"{prefix}/{key}" for key in block if key != axis)
-    limits = block.get(axis, {})
     prefix = f"{prefix}/{axis}"
-    if not isinstance(limits, dict):
-        raise ConfigError(prefix, limits, "a mapping such as {has_velocity_limits: true, max_velocity: 1.0}")
+    limits = check_mapping(prefix, block.get(axis), "a mapping such as {has_velocity_limits: true, max_velocity: 1.0}")
     known = set(_LIMIT_FLAGS)
     values = {}
     for flag in _LIMIT_FLAGS:

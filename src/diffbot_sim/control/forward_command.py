@@ -33,6 +33,7 @@ from typing import Optional, Tuple
 from diffbot_sim.control.angles import shortest_angular_distance, shortest_angular_distance_with_large_limits
 from diffbot_sim.control.pid import Pid, PidGains, no_p_gain_message, pid_gains, pid_publish_state
 from diffbot_sim.errors import ConfigError
+from diffbot_sim.values import check_mapping
 
 POSITION_INTERFACE = "PositionJointInterface"
 VELOCITY_INTERFACE = "VelocityJointInterface"
@@ -120,7 +121,7 @@ def forward_config(params, name, controller_type, joint_names_in_model):
         namespaces = tuple(f"{ns}/pid" if single else f"{ns}/{joint}/pid" for joint in joints)
         gains, publish = [], []
         for joint, pid_ns in zip(joints, namespaces):
-            pid_params = params.get("pid") if single else _sub_dict(params.get(joint), f"{ns}/{joint}").get("pid")
+            pid_params = params.get("pid") if single else check_mapping(f"{ns}/{joint}", params.get(joint)).get("pid")
             joint_gains = pid_gains(pid_params, pid_ns)
             if joint_gains is None:
                 raise ConfigError(f"{pid_ns}/p", None, f"a P gain ({no_p_gain_message(pid_ns)}; the controller "
@@ -131,14 +132,6 @@ def forward_config(params, name, controller_type, joint_names_in_model):
         if kind == "pid_position":
             config["specs"] = tuple(_joint_spec(joint, joint_names_in_model) for joint in joints)
     return ForwardConfig(**config)
-
-
-def _sub_dict(value, label):
-    if value is None:
-        return {}
-    if not isinstance(value, dict):
-        raise ConfigError(label, value, "a dictionary")
-    return value
 
 
 def _joint_names(params, ns, single, model):

@@ -35,7 +35,7 @@ from typing import Hashable, NamedTuple, Optional, Tuple
 
 from diffbot_sim.control.pid import Pid, PidGains, no_p_gain_message, pid_gains
 from diffbot_sim.errors import ConfigError
-from diffbot_sim.values import check_number
+from diffbot_sim.values import check_mapping, check_number
 
 POSITION_TYPE = "position_controllers/GripperActionController"
 EFFORT_TYPE = "effort_controllers/GripperActionController"
@@ -106,9 +106,7 @@ def gripper_action_config(params, name, controller_type):
     gains, warnings = None, []
     if variant == "effort":
         gains_ns = f"{ns}/gains/{joint}"
-        all_gains = params.get("gains", {})
-        if not isinstance(all_gains, dict):
-            raise ConfigError(f"{ns}/gains", all_gains, "a mapping of joint name -> PID gains")
+        all_gains = check_mapping(f"{ns}/gains", params.get("gains"), "a mapping of joint name -> PID gains")
         gains = pid_gains(all_gains.get(joint), gains_ns)
         if gains is None:
             warnings += [no_p_gain_message(gains_ns), NO_GAINS_WARNING]

@@ -12,7 +12,7 @@ from typing import Optional, Tuple
 from diffbot_sim.control.pid import PidGains, no_p_gain_message, pid_gains
 from diffbot_sim.control.trajectory import SegmentTolerances, StateTolerances
 from diffbot_sim.errors import ConfigError
-from diffbot_sim.values import check_bool, check_number
+from diffbot_sim.values import check_bool, check_mapping, check_number
 
 CONTROLLER_TYPES = {
     "position_controllers/JointTrajectoryController": "position",
@@ -70,13 +70,13 @@ def jtc_config(params, name, joints):
     if controller_type not in CONTROLLER_TYPES:
         raise ConfigError(f"{name}/type", controller_type, "one of " + ", ".join(CONTROLLER_TYPES))
     joint_names = _joint_names(params.get("joints"), f"{name}/joints", joints)
-    constraints = _sub_dict(params, "constraints", name)
+    constraints = check_mapping(f"{name}/constraints", params.get("constraints"))
     stopped_velocity = check_number(f"{name}/constraints/stopped_velocity_tolerance",
                                     constraints.get("stopped_velocity_tolerance", 0.01))
     goal_time = check_number(f"{name}/constraints/goal_time", constraints.get("goal_time", 0.0))
     tolerances = []
     for joint in joint_names:
-        own = _sub_dict(constraints, joint, f"{name}/constraints")
+        own = check_mapping(f"{name}/constraints/{joint}", constraints.get(joint))
         path = check_number(f"{name}/constraints/{joint}/trajectory", own.get("trajectory", 0.0))
         goal = check_number(f"{name}/constraints/{joint}/goal", own.get("goal", 0.0))
         tolerances.append(SegmentTolerances(StateTolerances(position=path),
@@ -111,15 +111,6 @@ def _joint_names(value, label, urdf_joints):
     return tuple(value)
 
 
-def _sub_dict(params, key, parent):
-    value = params.get(key)
-    if value is None:
-        return {}
-    if not isinstance(value, dict):
-        raise ConfigError(f"{parent}/{key}", value, "a dictionary")
-    return value
-
-
 def _closed_loop_gains(params, name, joint_names, controller_type):
     """``ClosedLoopHardwareInterfaceAdapter::init``: a PID per joint from ``gains/<joint>``, then
     ``velocity_ff/<joint>`` (default 0).
@@ -129,8 +120,8 @@ def _closed_loop_gains(params, name, joint_names, controller_type):
     ``starting()`` dereferences, and ``velocity_ff`` is left empty, which the first ``update()`` indexes:
     the process dies when the controller starts. That is reported in ``start_crash``.
     """
-    all_gains = _sub_dict(params, "gains", name)
-    feed_forward = _sub_dict(params, "velocity_ff", name)
+    all_gains = check_mapping(f"{name}/gains", params.get("gains"))
+    feed_forward = check_mapping(f"{name}/velocity_ff", params.get("velocity_ff"))
     gains = []
     for joint in joint_names:
         namespace = f"{name}/gains/{joint}"

@@ -1,6 +1,7 @@
 """ignition-math's pose conventions, as Gazebo classic applies them to what /gazebo services receive (pure):
-``Quaternion::Normalize`` (a near-zero quaternion is the identity), ``RotateVectorReverse``, ``Euler``. A pose is
-``((x, y, z), (qx, qy, qz, qw))``."""
+``Quaternion::Normalize`` (a near-zero quaternion is the identity), ``RotateVectorReverse``. A pose is
+``((x, y, z), (qx, qy, qz, qw))``. ``Quaternion::Euler``'s convention at gimbal lock is that of
+:func:`diffbot_sim.transforms.quaternion_rpy`."""
 import math
 
 from diffbot_sim.transforms import rotate
@@ -45,19 +46,3 @@ def unit_pose(pose):
     """A pose's numbers as floats, its quaternion normalised as ignition does."""
     p, q = pose
     return floats(p), unit(floats(q))
-
-
-def quaternion_rpy(q):
-    """(roll, pitch, yaw) of a quaternion (x, y, z, w), fixed axes as SDF and URDF write them
-    (R = Rz(yaw) Ry(pitch) Rx(roll)); at pitch +-pi/2 yaw is 0 and roll carries the rest, as ignition's
-    ``Quaternion::Euler`` (which Gazebo uses to write a spawned model's ``<pose>``) decides. Read from the
-    rotation matrix, so pitch stays exact near +-pi/2 where ``asin`` would lose half the digits."""
-    x, y, z, w = unit(floats(q))
-    r00, r10, r20 = 1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y)
-    r21, r22 = 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)
-    r11, r12 = 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)
-    cos_pitch = math.hypot(r00, r10)
-    pitch = math.atan2(-r20, cos_pitch)
-    if cos_pitch < 1e-12:
-        return math.atan2(-r12, r11), pitch, 0.0
-    return math.atan2(r21, r22), pitch, math.atan2(r10, r00)

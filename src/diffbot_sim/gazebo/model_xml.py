@@ -7,13 +7,13 @@ The functions edit the text in place (expat finds the byte offsets of the elemen
 not change stays byte-identical: comments, namespaces such as xmlns:xacro, formatting. Upstream re-prints
 the whole document through TinyXML instead; no client can tell the difference in the result.
 """
-import math
 import re
 from xml.parsers import expat
 from xml.sax.saxutils import escape
 
-from diffbot_sim.gazebo.ignition import IDENTITY, quaternion_rpy, unit, unit_pose
-from diffbot_sim.transforms import compose, rpy_quaternion
+from diffbot_sim.gazebo.ignition import IDENTITY, unit_pose
+from diffbot_sim.transforms import compose, quaternion_rpy
+from diffbot_sim.world.sdf_elements import read_pose
 
 _START_TAG = re.compile(rb'<[^\s/>]+(?:\s+[^\s=/>]+\s*=\s*(?:"[^"]*"|\'[^\']*\'))*\s*/?>')
 _ATTRIBUTE = re.compile(rb'(\s+)([^\s=/>]+)(\s*=\s*)("[^"]*"|\'[^\']*\')')
@@ -259,29 +259,13 @@ def rename_model(xml, kind, name):
     return _splice(data, [edit]).decode("utf-8")
 
 
-def _read_pose(data, el):
-    """An SDF ``<pose>`` element -> pose: six numbers (x y z roll pitch yaw) as Gazebo 11 reads them; SDF
-    1.9's ``degrees="true"`` and ``rotation_format="quat_xyzw"`` (seven numbers) are honoured too."""
-    text = "".join(el.text)
+def _read_pose(data, el, where):
+    """An SDF ``<pose>`` element -> pose, read as every SDF pose is (:func:`diffbot_sim.world.sdf_elements.read_pose`:
+    six numbers, SDF 1.9's ``degrees="true"`` and ``rotation_format="quat_xyzw"``, empty the identity)."""
     name_end = el.start + 1 + len(el.name.encode("utf-8"))
     attrs = {m.group(2).decode("utf-8"): m.group(4)[1:-1].decode("utf-8")
              for m in _ATTRIBUTE.finditer(data, name_end, el.tag_end)}
-    fmt = attrs.get("rotation_format", "euler_rpy")
-    try:
-        values = [float(v) for v in text.split()]
-    except ValueError:
-        values = None
-    count = 7 if fmt == "quat_xyzw" else 6
-    if fmt not in ("euler_rpy", "quat_xyzw") or values is None or len(values) != count \
-            or not all(math.isfinite(v) for v in values):
-        raise ValueError(f"model_xml: model <pose> '{text.strip()}' is not {count} finite numbers"
-                         + (f" (rotation_format '{fmt}')" if fmt != "euler_rpy" else ""))
-    if fmt == "quat_xyzw":
-        return tuple(values[:3]), unit(tuple(values[3:]))
-    rpy = values[3:]
-    if attrs.get("degrees", "false").strip().lower() in ("true", "1"):
-        rpy = [math.radians(v) for v in rpy]
-    return tuple(values[:3]), rpy_quaternion(*rpy)
+    return read_pose("".join(el.text), attrs, "model_xml", where)[0]
 
 
 def sdf_model_at(xml, pose):
@@ -291,9 +275,10 @@ def sdf_model_at(xml, pose):
     Upstream does not overwrite the model's own ``<pose>``: it composes it ON the requested pose (ignition
     ``model_pose + initial_pose``: the file's pose is read in the request's frame) and writes the result as
     a plain ``<pose>x y z roll pitch yaw</pose>`` (attributes such as ``relative_to`` dropped, as upstream's
-    new element has none). A ``<pose>`` that is not six numbers (seven with SDF 1.9
-    ``rotation_format="quat_xyzw"``; ``degrees="true"`` honoured) is a ValueError here; upstream logs and
-    uses zeros. The ``<sdf version>`` of the original is not part of the returned text: the caller keeps it.
+    new element has none). The ``<pose>`` is read as every SDF pose is (an empty one is the identity); one
+    that is not six numbers (seven with SDF 1.9 ``rotation_format="quat_xyzw"``; ``degrees="true"`` honoured)
+    is a ModelError here; upstream logs and uses zeros. The ``<sdf version>`` of the original is not part of
+    the returned text: the caller keeps it.
     """
     data, root = _scan(xml)
     target = _sdf_target(root)
@@ -301,7 +286,7 @@ def sdf_model_at(xml, pose):
     pose_el = target.child("pose")
     file_pose = IDENTITY
     if pose_el is not None:
-        file_pose = _read_pose(data, pose_el)
+        file_pose = _read_pose(data, pose_el, f"<{target.name}>/pose")
     (x, y, z), q = compose(pose, file_pose)
     text = " ".join(repr(float(v)) for v in (x, y, z) + quaternion_rpy(q))
     new = b"<pose>" + text.encode("ascii") + b"</pose>"
@@ -320,6 +305,6 @@ def sdf_model_frame(model_text):
     import xml.etree.ElementTree as ET
 
     root = ET.fromstring(model_text)
-    values = [float(v) for v in (root.findtext("pose") or "0 0 0 0 0 0").split()]
-    pose = (tuple(values[:3]), rpy_quaternion(*values[3:6]))
+    pose_el = root.find("pose")
+    pose = IDENTITY if pose_el is None else read_pose(pose_el.text, pose_el.attrib, "model_xml", "pose")[0]
     return pose, [link.get("name") for link in root.findall("link") if link.get("name")]

@@ -16,14 +16,14 @@
 The script is played by :mod:`diffbot_sim.world.actor_script`; ``libActorPlugin.so``'s walk by
 :mod:`diffbot_sim.world.actor_walk`.
 """
-import math
 from dataclasses import dataclass, field
 from typing import Optional, Tuple
 import xml.etree.ElementTree as ET
 
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.transforms import IGN_EQUAL, rpy_quaternion
+from diffbot_sim.transforms import IGN_EQUAL, quaternion_rpy, rpy_quaternion
 from diffbot_sim.values import check_bool, tag_number
+from diffbot_sim.world.sdf_elements import pose_numbers
 
 Vec3 = Tuple[float, float, float]
 Quat = Tuple[float, float, float, float]
@@ -157,16 +157,13 @@ def _child_bool(el, tag, default, where):
 
 
 def _pose6(el, where):
-    """A ``<pose>`` element's six numbers, strictly (as every pose in this project); empty or absent: zeros."""
-    text = "" if el is None else (el.text or "").strip()
-    if not text:
+    """A ``<pose>`` element's six numbers (x y z roll pitch yaw), read as every SDF pose is
+    (:func:`~diffbot_sim.world.sdf_elements.pose_numbers`); empty or absent: zeros."""
+    values = None if el is None else pose_numbers(el.text, el.attrib, element=where)
+    if values is None:
         return ZERO_POSE6
-    try:
-        values = tuple(float(v) for v in text.split())
-    except ValueError:
-        values = ()
-    if len(values) != 6 or not all(math.isfinite(v) for v in values):
-        raise ModelError(f"<pose> '{text}' is not 6 finite numbers", element=where)
+    if len(values) == 7:  # rotation_format="quat_xyzw"
+        return values[:3] + quaternion_rpy(values[3:])
     return values
 
 

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 from typing import Tuple
 
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.transforms import qnormalize, rpy_quaternion, wrap_angle
+from diffbot_sim.transforms import qnormalize, quaternion_rpy, rpy_quaternion, wrap_angle
 from diffbot_sim.values import check_number, tag_number
 
 Vec3 = Tuple[float, float, float]
@@ -129,20 +129,6 @@ def read_walker_config(description, plugin, path, notes):
 
 # ------------------------------------------------------------------------------------------ the walker
 
-def _euler(q):
-    """ign-math6 ``Quaternion::Euler``: (roll, pitch, yaw) rad of (x, y, z, w), singular pitch included."""
-    x, y, z, w = qnormalize(q)
-    squ, sqx, sqy, sqz = w * w, x * x, y * y, z * z
-    sarg = -2.0 * (x * z - w * y)
-    pitch = -0.5 * math.pi if sarg <= -1.0 else 0.5 * math.pi if sarg >= 1.0 else math.asin(sarg)
-    if abs(sarg - 1.0) < 1e-15:
-        return (math.atan2(2 * (x * y - z * w), squ - sqx + sqy - sqz), pitch, 0.0)
-    if abs(sarg + 1.0) < 1e-15:
-        return (math.atan2(-2 * (x * y - z * w), squ - sqx + sqy - sqz), pitch, 0.0)
-    return (math.atan2(2 * (y * z + w * x), squ - sqx - sqy + sqz), pitch,
-            math.atan2(2 * (x * y + w * z), squ + sqx - sqy - sqz))
-
-
 def _sub(a, b):
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
@@ -212,7 +198,7 @@ class ActorWalker:
         them). Returns the new :attr:`pose`."""
         obstacles = dict(obstacles or {})
         dt = sim_time - self.last_update
-        _, _, yaw = _euler(self.rotation)
+        _, _, yaw = quaternion_rpy(self.rotation)
         if _length(_sub(self.target, self.position)) < TARGET_REACHED:
             self._choose_new_target(obstacles)
         heading = self.steering(obstacles)
@@ -258,7 +244,7 @@ def upright_pose(pose, yaw_offset=0.0, root_height=0.0):
     pitch are dropped: the body stays upright.
     """
     (x, y, z), q = pose
-    return ((x, y, z - root_height), wrap_angle(_euler(q)[2] - yaw_offset))
+    return ((x, y, z - root_height), wrap_angle(quaternion_rpy(q)[2] - yaw_offset))
 
 
 def person_box(description, mesh_bounds=None):

@@ -3,9 +3,10 @@ visual's colour, a collision's shape and surface. Nothing here needs the names a
 world; :mod:`diffbot_sim.world.sdf_reader` resolves those.
 
 Numbers: a tag's leading number, the rest dropped with one warning (sdformat's ``std::stod``), non-finite
-values refused with the file and element named. Poses: SDF 1.9 ``degrees`` and ``rotation_format="quat_xyzw"``,
-``relative_to`` (1.5/1.6's ``frame`` is the same attribute before its rename) returned for the caller to
-resolve, an empty ``<pose/>`` the identity. Collisions: box, cylinder, sphere, plane (infinite), mesh; surface
+values refused with the file and element named. Poses (:func:`read_pose`, the one reader of an SDF ``<pose>``:
+worlds, actors, spawned models): SDF 1.9 ``degrees`` and ``rotation_format="quat_xyzw"``, ``relative_to``
+(1.5/1.6's ``frame`` is the same attribute before its rename) returned for the caller to resolve, an empty
+``<pose/>`` the identity. Collisions: box, cylinder, sphere, plane (infinite), mesh; surface
 ``mu``/``mu2`` (ODE, else Bullet), contact ``kp``/``kd`` and ``laser_retro``. Of visuals only the colour:
 ``<diffuse>``, else ``<ambient>``, else a ``<script><name>`` of :data:`GAZEBO_COLORS`.
 """
@@ -33,6 +34,63 @@ GAZEBO_COLORS = {
 }
 
 
+def _finite_numbers(text, count, what, source, element):
+    """Exactly ``count`` finite numbers in ``text`` (a tuple), else ModelError naming ``what``."""
+    parts = (text or "").split()
+    try:
+        values = tuple(float(v) for v in parts)
+    except ValueError:
+        values = ()
+    if len(values) != count or not all(math.isfinite(v) for v in values):
+        raise ModelError(f"{what} '{(text or '').strip()}' is not {count} finite number"
+                         f"{'s' if count > 1 else ''}", source, element)
+    return values
+
+
+def pose_numbers(text, attributes, source=None, element=None):
+    """The numbers of an SDF ``<pose>`` whose text is ``text`` and attributes ``attributes`` (a dict), read
+    strictly (every pose of this project is read here): None for an empty element (SDF's default, the
+    identity); else (x, y, z, roll, pitch, yaw) [m, rad] (SDF 1.9 ``degrees="true"``: the angles converted), or
+    with ``rotation_format="quat_xyzw"`` (x, y, z, qx, qy, qz, qw) as written.
+
+    Raises:
+        ModelError: not 6 (or 7) finite numbers, an unknown ``rotation_format``, a zero quaternion; naming
+            ``source`` and ``element``.
+    """
+    text = (text or "").strip()
+    if not text:
+        return None
+    fmt = (attributes.get("rotation_format") or "euler_rpy").strip()
+    if fmt == "quat_xyzw":
+        values = _finite_numbers(text, 7, "<pose> (quat_xyzw)", source, element)
+        if sum(c * c for c in values[3:]) < 1e-12:
+            raise ModelError("<pose> quaternion is zero", source, element)
+        return values
+    if fmt != "euler_rpy":
+        raise ModelError(f"<pose rotation_format='{fmt}'> is not euler_rpy or quat_xyzw", source, element)
+    values = _finite_numbers(text, 6, "<pose>", source, element)
+    if sdf_bool(attributes.get("degrees")):
+        values = values[:3] + tuple(math.radians(a) for a in values[3:])
+    return values
+
+
+def read_pose(text, attributes, source=None, element=None):
+    """An SDF ``<pose>`` (text and attributes, as :func:`pose_numbers` reads them) -> (pose ((x, y, z),
+    (qx, qy, qz, qw)), relative_to): an empty element is the identity, as in SDF; ``relative_to`` (1.5/1.6's
+    ``frame`` is the same attribute before its rename) is returned for the caller to resolve ("" if none).
+
+    Raises:
+        ModelError: as :func:`pose_numbers`.
+    """
+    relative_to = (attributes.get("relative_to") or attributes.get("frame") or "").strip()
+    values = pose_numbers(text, attributes, source, element)
+    if values is None:
+        return IDENTITY, relative_to
+    if len(values) == 7:
+        return ((values[0], values[1], values[2]), qnormalize(values[3:])), relative_to
+    return ((values[0], values[1], values[2]), rpy_quaternion(*values[3:])), relative_to
+
+
 def text_of(el, tag, default=None):
     """The stripped text of ``el``'s child ``tag`` (a path such as ``script/name`` works), or ``default``
     when it is missing or blank."""
@@ -58,15 +116,7 @@ class ElementReader:
 
     def floats(self, text, count, src, path, what):
         """Exactly ``count`` finite numbers in ``text`` (a tuple), else ModelError naming ``what``."""
-        parts = (text or "").split()
-        try:
-            values = tuple(float(v) for v in parts)
-        except ValueError:
-            values = ()
-        if len(values) != count or not all(math.isfinite(v) for v in values):
-            raise ModelError(f"{what} '{(text or '').strip()}' is not {count} finite number"
-                             f"{'s' if count > 1 else ''}", src.path, path)
-        return values
+        return _finite_numbers(text, count, what, src.path, path)
 
     def number(self, el, tag, default, src, path, positive=False):
         """The number in ``<tag>``, read as sdformat reads it (its leading number, the rest dropped with one
@@ -86,24 +136,8 @@ class ElementReader:
         return value
 
     def pose(self, el, src, path):
-        """``<pose>`` element -> (pose, relative_to). An empty element is the identity, as in SDF."""
-        rel = (el.get("relative_to") or el.get("frame") or "").strip()
-        text = (el.text or "").strip()
-        if not text:
-            return IDENTITY, rel
-        fmt = (el.get("rotation_format") or "euler_rpy").strip()
-        if fmt == "quat_xyzw":
-            v = self.floats(text, 7, src, path, "<pose> (quat_xyzw)")
-            if sum(c * c for c in v[3:]) < 1e-12:
-                raise ModelError("<pose> quaternion is zero", src.path, path)
-            return ((v[0], v[1], v[2]), qnormalize(v[3:])), rel
-        if fmt != "euler_rpy":
-            raise ModelError(f"<pose rotation_format='{fmt}'> is not euler_rpy or quat_xyzw", src.path, path)
-        v = self.floats(text, 6, src, path, "<pose>")
-        angles = v[3:]
-        if sdf_bool(el.get("degrees")):
-            angles = tuple(math.radians(a) for a in angles)
-        return ((v[0], v[1], v[2]), rpy_quaternion(*angles)), rel
+        """``<pose>`` element -> (pose, relative_to) (:func:`read_pose`)."""
+        return read_pose(el.text, el.attrib, src.path, path)
 
     def child_pose(self, el, src, path):
         """(pose, relative_to) of ``el``'s ``<pose>`` child; the identity without one."""

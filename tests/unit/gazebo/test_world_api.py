@@ -11,8 +11,9 @@ import xml.etree.ElementTree as ET
 import pytest
 
 from diffbot_sim.gazebo import model_xml, world_api as api
-from diffbot_sim.gazebo.ignition import IDENTITY, quaternion_rpy
-from diffbot_sim.transforms import compose, rpy_quaternion
+from diffbot_sim.errors import ModelError
+from diffbot_sim.gazebo.ignition import IDENTITY
+from diffbot_sim.transforms import compose, quaternion_rpy, rpy_quaternion
 
 S = math.sqrt(0.5)
 YAW90 = (0.0, 0.0, S, S)
@@ -398,8 +399,11 @@ def test_sdf_model_at_include_and_errors():
     include = '<sdf version="1.6"><world name="w"><include><uri>model://box</uri></include></world></sdf>'
     out = model_xml.sdf_model_at(include, ((1.0, 0.0, 0.0), (0, 0, 0, 1)))
     assert out.startswith("<include><uri>model://box</uri><pose>")
-    with pytest.raises(ValueError, match="not 6 finite numbers"):
+    with pytest.raises(ModelError, match=r"^model_xml: <model>/pose: <pose> '1 2 3' is not 6 finite numbers$"):
         model_xml.sdf_model_at('<sdf version="1.6"><model name="m"><pose>1 2 3</pose></model></sdf>', IDENTITY)
+    # an empty <pose/> is SDF's default, the identity (Gazebo reads it as zeros), as in a world file
+    out = model_xml.sdf_model_at('<sdf version="1.6"><model name="m"><pose/></model></sdf>', ((1.0, 0.0, 0.0), YAW90))
+    assert close(_pose_of(out)[0], (1.0, 0.0, 0.0)) and same_rotation(_pose_of(out)[1], YAW90)
 
 
 # ------------------------------------------------------------------------------------------ wrenches

@@ -114,6 +114,17 @@ def test_actor_without_script_gets_sdformats_default_script_and_a_note():
     assert notes == []
 
 
+def test_actor_poses_are_read_as_every_sdf_pose_is():
+    """The one <pose> reader (world.sdf_elements): SDF 1.9's forms too, and its message for a bad pose."""
+    s = math.sqrt(0.5)
+    desc = actor(f'<actor name="a"><pose rotation_format="quat_xyzw">1 2 0 0 0 {s} {s}</pose><script/></actor>')
+    assert desc.pose == pytest.approx((1.0, 2.0, 0.0, 0.0, 0.0, math.pi / 2))
+    desc = actor('<actor name="a"><pose degrees="true">1 2 0 0 0 90</pose><script/></actor>')
+    assert desc.pose == pytest.approx((1.0, 2.0, 0.0, 0.0, 0.0, math.pi / 2))
+    with pytest.raises(ModelError, match=r"/pose: <pose> '1 2 3' is not 6 finite numbers"):
+        actor('<actor name="a"><pose>1 2 3</pose><script/></actor>')
+
+
 def test_trajectories_play_in_id_order_back_to_back():
     first = trajectory(((0, "0 0 0 0 0 0"), (2, "2 0 0 0 0 0")), ident=1)
     second = trajectory(((0, "5 5 0 0 0 0"), (3, "5 8 0 0 0 0")), ident=-4, kind="other")
