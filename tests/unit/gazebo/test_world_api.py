@@ -10,8 +10,8 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from diffbot_sim.gazebo import model_xml, world_api as api
 from diffbot_sim.errors import ModelError
+from diffbot_sim.gazebo import model_xml, world_api as api
 from diffbot_sim.gazebo.ignition import IDENTITY
 from diffbot_sim.transforms import compose, quaternion_rpy, rpy_quaternion
 

@@ -11,13 +11,17 @@ from diffbot_sim.physics import World
 
 DT = 1.0 / 240.0
 WHEEL = """<robot name="wheel_on_a_post">
-  <link name="base"><inertial><mass value="100"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
-  <link name="wheel"><inertial><mass value="2"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
-  <joint name="axle" type="continuous"><parent link="base"/><child link="wheel"/><origin xyz="0 0 1"/><axis xyz="0 1 0"/></joint>
+  <link name="base"><inertial><mass value="100"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+    </link>
+  <link name="wheel"><inertial><mass value="2"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
+  <joint name="axle" type="continuous"><parent link="base"/><child link="wheel"/><origin xyz="0 0 1"/>
+    <axis xyz="0 1 0"/></joint>
 </robot>"""
 #: an OpenMANIPULATOR-sized link (0.1 kg, 0.1 m): Gazebo-tuned p = 300 is far beyond its bound at 1/240 s
 ARM = """<robot name="one_link_arm">
-  <link name="base"><inertial><mass value="100"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="base"><inertial><mass value="100"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+    </link>
   <link name="link"><inertial><origin xyz="0.05 0 0"/><mass value="0.1"/>
     <inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
   <joint name="shoulder" type="revolute"><parent link="base"/><child link="link"/><origin xyz="0 0 1"/>
@@ -75,8 +79,9 @@ def test_joint_inertias_are_what_the_motor_moves():
     free_wheel = WHEEL.replace('<origin xyz="0 0 1"/>', '<origin xyz="0 0 0"/>')
     _, wheel = run(free_wheel, "axle", lambda *a: None, seconds=DT)
     assert wheel == pytest.approx(0.01 * 1.0 / (0.01 + 1.0), rel=1e-6)
-    light_base = free_wheel.replace('<mass value="100"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"',
-                                    '<mass value="4"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"')
+    light_base = free_wheel.replace(
+        '<mass value="100"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"',
+        '<mass value="4"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"')
     _, wheel = run(light_base, "axle", lambda *a: None, seconds=DT)
     assert wheel == pytest.approx(0.005, rel=1e-6)  # half the diagonal: the base spins back as much
 

@@ -19,7 +19,8 @@ ARM = """<robot name="tipping_arm">
     </inertial><collision><origin xyz="0 0 0.05"/><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
   <link name="flange"><inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/>
     </inertial></link>
-  <joint name="flange_joint" type="fixed"><parent link="link_base"/><child link="flange"/><origin xyz="0 0 0.1"/></joint>
+  <joint name="flange_joint" type="fixed"><parent link="link_base"/><child link="flange"/>
+    <origin xyz="0 0 0.1"/></joint>
   <link name="upper_arm"><inertial><origin xyz="0.25 0 0"/><mass value="3"/>
     <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.06" iyz="0" izz="0.06"/></inertial>
     <collision><origin xyz="0.25 0 0"/><geometry><box size="0.5 0.05 0.05"/></geometry></collision></link>

@@ -16,8 +16,16 @@ from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.transforms import slerp
 from diffbot_sim.world.actor_script import ActorScript
 from diffbot_sim.world.actor_sdf import pose6_to_pose, read_actor
-from diffbot_sim.world.actor_walk import (FLOOR_X, FLOOR_Y, PERSON_SIZE, WALK_ROOT_HEIGHT, ActorWalker,
-                                          person_box, read_walker_config, upright_pose)
+from diffbot_sim.world.actor_walk import (
+    FLOOR_X,
+    FLOOR_Y,
+    PERSON_SIZE,
+    WALK_ROOT_HEIGHT,
+    ActorWalker,
+    person_box,
+    read_walker_config,
+    upright_pose,
+)
 
 PATH = "test.world: /sdf/world/actor"
 
