@@ -11,8 +11,9 @@ the ROS parameter ``<ns>/base_prefix`` (a ``<base_prefix>`` tag also accepted; d
 in), ``odom`` (frames ``odom`` -> ``base_footprint``, fixed as in the original; TF when ``publish_tf``),
 ``joint_states`` (both wheels), ``<base_prefix>/sensors/imu_data`` (sensor_msgs/Imu of the base).
 Odometry integrates wheel speed x radius for distance and the IMU's yaw rate for heading, as the original
-does. ``commands/motor_power`` and ``events/cliff|bumper`` need kobuki_msgs, which Debian does not ship:
-named once in a warning.
+does. With kobuki_msgs (the overlay's): ``<base_prefix>/commands/motor_power`` (MotorPower: off, the wheels
+are held at rest), ``events/bumper``, ``events/cliff``, ``events/wheel_drop`` and ``sensors/core``
+(:mod:`.kobuki_events`).
 """
 import math
 
@@ -29,6 +30,7 @@ from diffbot_sim.errors import ModelError
 from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import DRIVE_TWIST, Plugin, join, twist_callback
 from diffbot_sim.plugins.joint_motors import UNLIMITED_EFFORT
+from diffbot_sim.plugins.kobuki_events import KobukiEvents
 from diffbot_sim.transforms import quaternion_from_yaw
 from diffbot_sim.values import check_bool, check_string, tag_number
 
@@ -36,7 +38,8 @@ REQUIRED = ("left_wheel_joint_name", "right_wheel_joint_name", "wheel_separation
             "torque", "velocity_command_timeout")
 ACCEPTED = ("cliff_sensor_left_name", "cliff_sensor_center_name", "cliff_sensor_front_name",
             "cliff_sensor_right_name", "cliff_detection_threshold", "bumper_name", "base_collision_model_link",
-            "robotNamespace", "publish_tf", "imu_name", "update_rate", "base_prefix", "alwaysOn")
+            "robotNamespace", "publish_tf", "imu_name", "update_rate", "base_prefix", "alwaysOn",
+            "wheel_drop_left_sensor_name", "wheel_drop_right_sensor_name")
 #: The original's fixed odometry covariances (pose x, y, yaw; unobserved axes 1e6).
 POSE_COVARIANCE = (0.1, 0.1, 1e6, 1e6, 1e6, 0.05)
 
@@ -44,9 +47,10 @@ POSE_COVARIANCE = (0.1, 0.1, 1e6, 1e6, 1e6, 0.05)
 class Kobuki(Plugin):
     filename = "libgazebo_ros_kobuki.so"
 
-    def __init__(self, ctx, values, path, base_prefix, ns):
+    def __init__(self, ctx, values, path, base_prefix, ns, tags=None):
         self.ctx = ctx
         self.values = values
+        tags = tags or {}
         model, robot = ctx.model, ctx.robot
         self.joints_ = [values["left_wheel_joint_name"], values["right_wheel_joint_name"]]
         for name in self.joints_:
@@ -82,19 +86,32 @@ class Kobuki(Plugin):
         self.js_builder = ros_msgs.JointStateBuilder(self.joints_)
         self.imu_frame = ctx.frame("base_link")
         self.topics = {"cmd_vel_topic": self.cmd_sub.resolved_name, "odom_topic": self.odom_pub.resolved_name}
-        ctx.warnings.append(f"{path}: {join(ns, prefix)}/commands/motor_power and events/cliff, events/bumper "
-                            "are not simulated (their kobuki_msgs types are not in Debian)")
+        self.motors_enabled = True
+        self.events, self.power_sub = None, None
+        try:
+            from kobuki_msgs.msg import MotorPower
+
+            self.events = KobukiEvents(ctx, tags, path, ns, prefix)
+            self.power_sub = ctx.subscriber(join(ns, f"{prefix}/commands/motor_power"), MotorPower,
+                                            self._on_motor_power, queue_size=10)
+        except ImportError:  # the overlay left out
+            ctx.warnings.append(f"{path}: kobuki_msgs is not built (overlay left out): no {join(ns, prefix)}/events/"
+                                "bumper, cliff, wheel_drop, sensors/core, commands/motor_power")
 
     # -- callbacks ----------------------------------------------------------------------------------
     def _on_reset(self, _msg):
         self._reset_odom = True
+
+    def _on_motor_power(self, msg):
+        self.motors_enabled = msg.state == msg.ON  # read on the loop's next command update
+        self.ctx.sim.wake.set()
 
     # -- loop ---------------------------------------------------------------------------------------
     def joints(self):
         return set(self.joints_)
 
     def publishers(self):
-        return [self.odom_pub, self.js_pub, self.imu_pub]
+        return [self.odom_pub, self.js_pub, self.imu_pub] + (self.events.publishers() if self.events else [])
 
     def next_control(self):
         if self.cmd_time is not None and self.wheel_cmd != (0.0, 0.0):
@@ -109,12 +126,12 @@ class Kobuki(Plugin):
             self.cmd_time = now
         elif self.cmd_time is not None and now - self.cmd_time > self.timeout:
             self.wheel_cmd, self.cmd_time = (0.0, 0.0), None  # stale: stop, as the original does
-        elif self.holding:
+        elif self.holding and self.motors_enabled:
             return  # the motors keep their targets
         # The original sets the wheel velocities with the torque limit on every update, from the first one: the
         # wheels are held at 0 before any command (free wheels let a robot on frictionless casters roll away).
         self.holding = True
-        left, right = self.wheel_cmd
+        left, right = self.wheel_cmd if self.motors_enabled else (0.0, 0.0)  # motors off: no speed, as upstream
         self.ctx.robot.set_velocities(self.idx, [left / self.radius, right / self.radius], [self.torque] * 2)
 
     def after_step(self, now, stamp, transforms):
@@ -148,6 +165,8 @@ class Kobuki(Plugin):
         _, rates, accel, self._imu_velocity = robot.link_imu(self.ctx.model.root, self._imu_velocity, dt)
         if self.imu_pub.get_num_connections():
             self.imu_pub.publish(ros_msgs.imu(stamp, self.imu_frame, pose[1], rates, accel))
+        if self.events is not None:
+            self.events.update(stamp)
 
     def start(self, now):
         self.next = self.last_time = now
@@ -190,4 +209,4 @@ def create(ctx, element, path, params):
     ns = ctx.plugin_namespace(tags.get("robotNamespace"), "/")
     # The original reads base_prefix as a ROS parameter of its node handle (<ns>/base_prefix).
     base_prefix = tags.get("base_prefix") or rospy.get_param(join(ns, "base_prefix"), "mobile_base")
-    return Kobuki(ctx, values, path, str(base_prefix), ns)
+    return Kobuki(ctx, values, path, str(base_prefix), ns, tags)

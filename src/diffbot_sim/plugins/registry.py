@@ -6,6 +6,7 @@ PluginBlocks; every other one from its element by its module's ``create(ctx, ele
 from diffbot_sim.description.plugin_tags import DIFF_DRIVE, JOINT_STATE, plugin_filename
 from diffbot_sim.errors import PluginNotLoaded
 from diffbot_sim.plugins import (
+    bumper,
     diff_drive,
     force_based_move,
     gps,
@@ -57,6 +58,7 @@ SENSOR_PLUGINS = {
     "libgazebo_ros_velodyne_gpu_laser.so": ray_clouds.create_velodyne,
     "libgazebo_ros_camera.so": create_camera,
     "libgazebo_ros_openni_kinect.so": create_depth,
+    "libgazebo_ros_bumper.so": bumper.create,
 }
 #: Every filename simulated (the rest are named once as not simulated).
 KNOWN = (DIFF_DRIVE, JOINT_STATE) + tuple(MODEL_PLUGINS)
