@@ -15,6 +15,7 @@ from diffbot_sim.plugins import (
     joint_state,
     kobuki,
     mimic_joint,
+    multicamera,
     p3d,
     planar_move,
     ray_clouds,
@@ -59,6 +60,7 @@ SENSOR_PLUGINS = {
     "libgazebo_ros_camera.so": create_camera,
     "libgazebo_ros_openni_kinect.so": create_depth,
     "libgazebo_ros_bumper.so": bumper.create,
+    "libgazebo_ros_multicamera.so": multicamera.create,
 }
 #: Every filename simulated (the rest are named once as not simulated).
 KNOWN = (DIFF_DRIVE, JOINT_STATE) + tuple(MODEL_PLUGINS)
