@@ -198,6 +198,7 @@ def build_report(path, model_args="", controller_files=(), known=(), known_senso
             sim_type = values.get("robotSimType") or DEFAULT_SIM_TYPE
             if sim_type != DEFAULT_SIM_TYPE:
                 warnings.append(f"{other.path}: robotSimType '{sim_type}' is not simulated; using {DEFAULT_SIM_TYPE}")
+            warnings.extend(f"gazebo_ros_control: {skipped.warning}" for skipped in model.other_transmissions)
             controllers = find_controllers(tree, ns)
             control_ns, control_controllers = ns, controllers
             if not controllers:

@@ -134,6 +134,24 @@ class Transmission:
 
 
 @dataclass
+class OtherTransmission:
+    """A ``<transmission>`` gazebo_ros_control's DefaultRobotHWSim does not simulate: one over several joints
+    (franka_hw's ``FrankaStateInterface`` and ``FrankaModelInterface`` name every joint of the arm) or one whose
+    hardware interface is none of JOINT_INTERFACES. Kept as read, for a ``robotSimType`` that uses it; the
+    default hardware skips it with :attr:`warning`, as DefaultRobotHWSim's ``initSim`` warns and skips it."""
+
+    name: str
+    type: str
+    joints: List[str]
+    interfaces: List[str]  # each joint's first <hardwareInterface>, as written ("" when it has none)
+    why: str  # why DefaultRobotHWSim skips it
+
+    @property
+    def warning(self):
+        return f"transmission '{self.name}' ({self.type}) skipped by DefaultRobotHWSim: {self.why}"
+
+
+@dataclass
 class GazeboBlock:
     """A ``<gazebo>`` element; ``reference`` is the link (or joint) it applies to, None for the robot."""
 
@@ -158,6 +176,8 @@ class RobotModel:
     #: does (the model's base is fixed where it is spawned). Empty for a free robot.
     world_joints: List[Joint] = field(default_factory=list)
     warnings: List[str] = field(default_factory=list)  # published mistakes survived, one line each
+    #: The transmissions DefaultRobotHWSim does not simulate (``transmissions`` holds those it does).
+    other_transmissions: List[OtherTransmission] = field(default_factory=list)
     _surfaces: Dict[str, dict] = field(default_factory=dict, repr=False)
 
     @property
@@ -318,7 +338,8 @@ def parse_urdf(text, source="robot_description"):
         canonical = world_joints[0].child  # the world link itself is not loaded (WORLD_LINK)
     model = RobotModel(name, source, links, joints, [], [], canonical, world_joints)
     for index, el in enumerate(root.findall("transmission"), start=1):
-        model.transmissions.append(_transmission(el, index, model))
+        trans = _transmission(el, index, model)
+        (model.other_transmissions if isinstance(trans, OtherTransmission) else model.transmissions).append(trans)
     for index, el in enumerate(root.findall("gazebo"), start=1):
         ref = el.get("reference")
         path = f"/robot/gazebo[@reference='{ref}']" if ref else f"/robot/gazebo[{index}]"
@@ -340,11 +361,15 @@ def _transmission(el, index, model):
     if not ttype:
         raise ModelError("has no <type> (e.g. transmission_interface/SimpleTransmission)", source, path)
     joint_els = el.findall("joint")
-    if len(joint_els) != 1:
-        raise ModelError(f"must name exactly one <joint>, found {len(joint_els)}", source, path)
+    if not joint_els:
+        raise ModelError("names no <joint>", source, path)
+    if len(joint_els) > 1:
+        names = [_required(j, "name", source, f"{path}/joint") for j in joint_els]
+        return OtherTransmission(tname or f"transmission_{index}", ttype, names,
+                                 [(j.findtext("hardwareInterface") or "").strip() for j in joint_els],
+                                 f"it names {len(names)} joints; DefaultRobotHWSim simulates one per transmission")
     jname = _required(joint_els[0], "name", source, f"{path}/joint")
     jpath = f"{path}/joint[@name='{jname}']"
-    model.joint(jname, jpath)
     actuator = el.find("actuator")
     interfaces = [i.text for i in joint_els[0].findall("hardwareInterface")]
     if not interfaces and actuator is not None:  # deprecated: interface only on the actuator
@@ -356,8 +381,11 @@ def _transmission(el, index, model):
                               f"first, {(interfaces[0] or '').strip()}, as gazebo_ros_control does")
     interface = (interfaces[0] or "").strip().split("/")[-1]
     if interface not in JOINT_INTERFACES:
-        raise ModelError(f"hardware interface '{interfaces[0]}' is not one of {', '.join(JOINT_INTERFACES)}",
-                         source, f"{jpath}/hardwareInterface")
+        given = (interfaces[0] or "").strip()
+        return OtherTransmission(tname or f"transmission_{index}", ttype, [jname], [given],
+                                 f"its hardware interface '{given}' is not one it simulates "
+                                 f"({', '.join(JOINT_INTERFACES)})")
+    model.joint(jname, jpath)  # only now: a transmission DefaultRobotHWSim skips never looks its joint up
     reduction, offset = 1.0, 0.0
     red_el = actuator.find("mechanicalReduction") if actuator is not None else el.find("mechanicalReduction")
     if red_el is not None:

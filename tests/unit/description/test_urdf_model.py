@@ -120,11 +120,14 @@ def test_transmission_naming_missing_joint(make_urdf, make_transmission):
     assert "left_wheel_joint" in message
 
 
-def test_unknown_hardware_interface(make_urdf):
-    err = _error(make_urdf(left_interface="hardware_interface/FooJointInterface"))
-    assert "FooJointInterface" in str(err)
-    assert "transmission[@name='left_wheel_joint_trans']" in str(err)
-    assert err.element.endswith("/hardwareInterface")
+def test_unknown_hardware_interface_is_kept_apart(parse, make_urdf):
+    # DefaultRobotHWSim skips it with a warning (plugins/ros_control/hardware.py); the robot loads
+    model = parse(make_urdf(left_interface="hardware_interface/FooJointInterface"))
+    assert [t.joint for t in model.transmissions] == ["right_wheel_joint"]
+    (other,) = model.other_transmissions
+    assert (other.name, other.joints, other.interfaces) == ("left_wheel_joint_trans", ["left_wheel_joint"],
+                                                            ["hardware_interface/FooJointInterface"])
+    assert "'hardware_interface/FooJointInterface' is not one it simulates" in other.warning
 
 
 @pytest.mark.parametrize("interface", ["hardware_interface/EffortJointInterface", "EffortJointInterface"])

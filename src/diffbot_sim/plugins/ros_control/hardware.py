@@ -90,6 +90,8 @@ class RobotHWSim:
         self.joints = {}  # name -> SimJoint, in transmission order
         model, robot = ctx.model, ctx.robot
         dt = ctx.cfg.time_step
+        for other in model.other_transmissions:  # several joints, or an interface it has no handle for
+            warnings.append(f"gazebo_ros_control: {other.warning}")
         for trans in model.transmissions:
             if trans.joint not in robot.joint_index:
                 warnings.append(f"gazebo_ros_control: joint '{trans.joint}' of transmission '{trans.name}' is not "
