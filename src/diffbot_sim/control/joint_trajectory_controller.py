@@ -26,8 +26,16 @@ from typing import Hashable, NamedTuple, Optional, Tuple
 from diffbot_sim.control.angles import shortest_angular_distance
 from diffbot_sim.control.joint_trajectory_config import JtcConfig
 from diffbot_sim.control.pid import Pid
-from diffbot_sim.control.trajectory import (TrajectoryError, hold_trajectory, joint_mapping, merge_trajectory,
-                                            resolve_goal_tolerances, sample, to_ns, to_sec)
+from diffbot_sim.control.trajectory import (
+    TrajectoryError,
+    hold_trajectory,
+    joint_mapping,
+    merge_trajectory,
+    resolve_goal_tolerances,
+    sample,
+    to_ns,
+    to_sec,
+)
 from diffbot_sim.errors import DiffbotSimError
 
 # control_msgs/FollowJointTrajectoryResult error codes.

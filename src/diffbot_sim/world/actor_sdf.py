@@ -16,9 +16,9 @@
 The script is played by :mod:`diffbot_sim.world.actor_script`; ``libActorPlugin.so``'s walk by
 :mod:`diffbot_sim.world.actor_walk`.
 """
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from typing import Optional, Tuple
-import xml.etree.ElementTree as ET
 
 from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.transforms import IGN_EQUAL, quaternion_rpy, rpy_quaternion
