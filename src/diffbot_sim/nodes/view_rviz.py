@@ -21,11 +21,11 @@ status is rviz's.
 import argparse
 import os
 import sys
-import time
 
 from diffbot_sim import streams
 from diffbot_sim.errors import DiffbotSimError
 from diffbot_sim.view import rviz_config
+from diffbot_sim.waiting import wait_for
 
 def default_template():
     """The package's ``rviz/diffbot.rviz``, found as roslaunch finds package files (rospkg): in a source
@@ -59,15 +59,12 @@ def _param(master, name, default=None):
 
 
 def _wait_param(master, name, timeout):
-    deadline = time.monotonic() + timeout
-    while True:
+    """The parameter ``name`` once it exists (an empty value counts), through ``waiting.wait_for``."""
+    def present():
         value = _param(master, name)
-        if value is not None:
-            return value
-        if time.monotonic() > deadline:
-            raise DiffbotSimError(f"view_rviz: no parameter {name} after {timeout:g} s: the simulator did not "
-                                  "report its robots (is bullet_sim running?)")
-        time.sleep(0.2)
+        return None if value is None else [value]
+    return wait_for(present, timeout, f"parameter {name}", 0.2, error=lambda message: DiffbotSimError(
+        f"view_rviz: {message}: the simulator did not report its robots (is bullet_sim running?)"))[0]
 
 
 def robot_views(master, sim, timeout):

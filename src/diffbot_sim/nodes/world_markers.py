@@ -45,11 +45,15 @@ def odom_offset(source, x, y, yaw):
 
 
 def _wait(predicate, timeout, what):
-    """``waiting.wait_for`` as this node fails: one line naming itself, ended early by a ROS shutdown."""
+    """``predicate()``'s first value that is not None (an empty one counts), through ``waiting.wait_for`` as this
+    node fails: one line naming itself, ended early by a ROS shutdown."""
     import rospy
 
-    return wait_for(predicate, timeout, what, 0.1, give_up=lambda: rospy.is_shutdown() and "shut down",
-                    error=lambda message: DiffbotSimError(f"world_markers: {message} (is bullet_sim running?)"))
+    def present():
+        value = predicate()
+        return None if value is None else [value]
+    return wait_for(present, timeout, what, 0.1, give_up=lambda: rospy.is_shutdown() and "shut down",
+                    error=lambda message: DiffbotSimError(f"world_markers: {message} (is bullet_sim running?)"))[0]
 
 
 def _odom_frames(sim, timeout):
