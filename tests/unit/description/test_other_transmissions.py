@@ -46,7 +46,8 @@ def test_a_skipped_transmission_never_looks_its_joints_up():
 
 def test_a_transmission_without_a_joint_is_still_refused():
     text = fixture_text().replace(
-        '<joint name="wrist_joint"><hardwareInterface>hardware_interface/PosVelJointInterface</hardwareInterface></joint>',
+        '<joint name="wrist_joint"><hardwareInterface>hardware_interface/PosVelJointInterface</hardwareInterface>'
+        '</joint>',
         '')
     with pytest.raises(ModelError, match=r"transmission\[@name='wrist_trans'\]: names no <joint>"):
         parse_urdf(text, FIXTURE)

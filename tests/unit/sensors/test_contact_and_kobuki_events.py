@@ -16,7 +16,7 @@ def test_states_group_pairs_and_rotate_wrenches_into_the_link_frame():
     points = [Point(7, -1, (1.0, 0.0, 0.1), (-1.0, 0.0, 0.0), 0.001, (-2.0, 0.0, 0.0)),
               Point(7, -1, (1.0, 0.1, 0.1), (-1.0, 0.0, 0.0), 0.002, (-3.0, 0.0, 0.0)),
               Point(9, 2, (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), 0.0, (0.0, 0.0, 5.0))]
-    states = contact_states(points, "r::base::c", lambda b, l: f"body{b}", (0.0, 0.0, 0.1), q)
+    states = contact_states(points, "r::base::c", lambda body, _link: f"body{body}", (0.0, 0.0, 0.1), q)
     assert [s.collision2 for s in states] == ["body7", "body9"]
     first = states[0]
     assert first.depths == [0.001, 0.002] and first.positions[1] == (1.0, 0.1, 0.1)
