@@ -9,6 +9,8 @@ without ``<inertial>`` counts as 1 kg. So we lump ourselves, before PyBullet see
 * a fixed child whose collisions share the surface of the body it joins (or that has no collision) is
   lumped: inertials combined, collisions and visuals moved with their origins composed, its child joints
   re-attached; its frame is remembered (``frames``) so sensors can still be mounted on it;
+* a fixed joint ``<gazebo reference>`` keeps (``preserveFixedJoint``, ``disableFixedJointLumping``) stays a
+  PyBullet fixed joint, as sdformat keeps it;
 * a fixed child whose collisions have a surface of their own stays a separate PyBullet link on a fixed
   joint (rigid in PyBullet's Featherstone multibody), so its shapes keep their friction;
 * a link without ``<inertial>`` adds no mass: lumped, it adds nothing; kept for its surface on a fixed joint,
@@ -174,6 +176,18 @@ def _transform_inertial(part, t):
     return mass, r @ com + t[:3, 3], r @ inertia @ r.T
 
 
+def preserved_fixed_joints(root):
+    """Fixed joints sdformat keeps: ``<gazebo reference="joint"><preserveFixedJoint>true`` (or the older
+    ``disableFixedJointLumping``), e.g. the joint of a force-torque sensor, which must exist to be measured."""
+    kept = set()
+    for block in root.findall("gazebo"):
+        for child in block:
+            if child.tag in ("preserveFixedJoint", "disableFixedJointLumping") and \
+                    (child.text or child.get("value") or "").strip() in ("true", "1"):
+                kept.add(block.get("reference"))
+    return kept
+
+
 def lump(urdf_text, root_link, surface):
     """Lump fixed-joint children as described in the module docstring.
 
@@ -189,6 +203,7 @@ def lump(urdf_text, root_link, surface):
     root = ET.fromstring(urdf_text)
     links = {el.get("name"): el for el in root.findall("link")}
     joints = root.findall("joint")
+    kept = preserved_fixed_joints(root)
     children = {}
     for joint in joints:
         parent = joint.find("parent").get("link")
@@ -213,7 +228,7 @@ def lump(urdf_text, root_link, surface):
             t = offset[name] @ origin_matrix(joint)
             carrier = body[name]
             has_collision = links[child].find("collision") is not None
-            if (joint.get("type") == "fixed" and name != WORLD_LINK
+            if (joint.get("type") == "fixed" and name != WORLD_LINK and joint.get("name") not in kept
                     and (not has_collision or key(child) == key(carrier))):
                 body[child], offset[child] = carrier, t
                 lumped.append(child)

@@ -9,6 +9,7 @@ from diffbot_sim.plugins import (
     bumper,
     diff_drive,
     force_based_move,
+    force_torque,
     gps,
     grasp_fix,
     imu,
@@ -45,6 +46,7 @@ MODEL_PLUGINS = {
     "libgazebo_grasp_fix.so": grasp_fix.create,
     "libroboticsgroup_gazebo_mimic_joint_plugin.so": mimic_joint.create,
     "libroboticsgroup_upatras_gazebo_mimic_joint_plugin.so": mimic_joint.create,
+    "libgazebo_ros_ft_sensor.so": force_torque.create_model,
 }
 #: Sensor plugins by filename: ``create(ctx, sensor, plugin_element, params)`` with ``sensor`` a
 #: :class:`~diffbot_sim.description.plugin_tags.SensorElement` (its type, link, element and path). One line per module.
@@ -61,6 +63,7 @@ SENSOR_PLUGINS = {
     "libgazebo_ros_openni_kinect.so": create_depth,
     "libgazebo_ros_bumper.so": bumper.create,
     "libgazebo_ros_multicamera.so": multicamera.create,
+    "libgazebo_ros_ft_sensor.so": force_torque.create_sensor,
 }
 #: Every filename simulated (the rest are named once as not simulated).
 KNOWN = (DIFF_DRIVE, JOINT_STATE) + tuple(MODEL_PLUGINS)
