@@ -96,16 +96,17 @@ class Sim:
 
 
 class ArmRig:
-    """One fixture arm standing on the ground, its YAML on the 'parameter server'."""
+    """One fixture arm standing on the ground; on the 'parameter server' its YAML (unless ``use_yaml`` is false)
+    updated with ``params``."""
 
-    def __init__(self, name, params=None):
+    def __init__(self, name, params=None, use_yaml=True):
         path = os.path.join(ROBOTS, f"{name}.urdf")
         text = open(path).read()
         self.model = parse_urdf(text, path)
         self.world = World(DT)
         self.robot = self.world.load_robot(text, self.model)
         yaml_path = os.path.join(ROBOTS, f"{name}.yaml")
-        self.params = (yaml.safe_load(open(yaml_path)) or {}) if os.path.exists(yaml_path) else {}
+        self.params = (yaml.safe_load(open(yaml_path)) or {}) if use_yaml and os.path.exists(yaml_path) else {}
         self.params.update(params or {})
         self.sim = Sim(self.world)
         cfg = SimpleNamespace(time_step=DT, autostart_controllers=False)
@@ -123,11 +124,11 @@ class ArmRig:
 
 @pytest.fixture
 def arm_rig():
-    """``arm_rig(name, params=None)`` -> an :class:`ArmRig`, closed after the test."""
+    """``arm_rig(name, params=None, use_yaml=True)`` -> an :class:`ArmRig`, closed after the test."""
     made = []
 
-    def make(name, params=None):
-        made.append(ArmRig(name, params))
+    def make(name, params=None, use_yaml=True):
+        made.append(ArmRig(name, params, use_yaml))
         return made[-1]
     yield make
     for rig in made:
