@@ -9,13 +9,14 @@ import rospy
 from control_msgs.msg import FollowJointTrajectoryAction, FollowJointTrajectoryGoal, JointTolerance
 from gazebo_msgs.srv import GetLinkState
 from sensor_msgs.msg import JointState
+from simtest import action_done, wait_for
 from std_srvs.srv import Empty
+from stillness import held_still
+from traittest import sim_now
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from diffbot_sim.check.arm_check import pose_errors
 from diffbot_sim.description.urdf_model import parse_urdf
-from simtest import action_done, wait_for
-from traittest import sim_now
 
 
 class JointStates:
@@ -82,25 +83,14 @@ class JointStates:
             with self.lock:
                 messages = [(t, p) for t, p in self.history if t >= since]
                 latest = dict(self.positions)
-            if not messages:
+            wanted = names if names is not None else sorted({n for _, p in messages for n in p})
+            if not wanted:
                 return None
-            last = messages[-1][0]
-            if last - messages[0][0] < window - 1e-9:
-                worst[0] = f"{last - messages[0][0]:.3f} s of sim time seen so far"
-                return None
-            recent = [p for t, p in messages if t >= last - window - 1e-9]
-            wanted = names if names is not None else sorted({n for p in recent for n in p})
-            spread = {}
-            for name in wanted:
-                values = [p[name] for p in recent if name in p]
-                if not values:
-                    worst[0] = f"no {name} in the window"
+            for name in wanted:  # each joint on the messages that carry it (several publishers may merge)
+                ok, why = held_still([(t, [p[name]]) for t, p in messages if name in p], band, window)
+                if not ok:
+                    worst[0] = f"{name}: {why}"
                     return None
-                spread[name] = max(values) - min(values)
-            widest = max(spread, key=spread.get)
-            if spread[widest] > band:
-                worst[0] = f"{widest} moved {spread[widest]:.5f} over the last {window} s"
-                return None
             return latest if names is None else [latest[n] for n in names]
         try:
             return wait_for(still, timeout, f"the joints settled (within {band} over {window} s of sim time)")

@@ -195,8 +195,10 @@ class Recorder:
         return msg.header.stamp.to_sec() if msg else 0.0
 
     def wait_sim(self, seconds, timeout=60.0):
-        """Wait until sim time has advanced by ``seconds``; returns the new sim time."""
-        start = self.sim_time()
+        """Wait until odom stamped ``seconds`` after the simulator's sim time now (sim_now: the newest odom this
+        node holds may be older on a busy machine, and counting from it would end the wait early) has arrived;
+        returns the newest odom stamp."""
+        start = sim_now()
         return self.wait(lambda: self.sim_time() >= start + seconds and self.sim_time(), timeout,
                          f"sim time to advance {seconds} s from {start:.3f}")
 
@@ -257,7 +259,7 @@ def reset_robot(rec):
     robot back at rest."""
     rec.send(0.0, 0.0)
     call(SIM + "/reset_world")  # time goes on (reset_simulation would send it back to 0)
-    after = rec.sim_time() + 0.1  # the service returned: anything stamped later follows the reset
+    after = sim_now()  # the service returned: anything stamped later follows the reset, whatever this node holds
 
     def at_rest():
         msg = rec.last(rec.odom)

@@ -123,6 +123,16 @@ class ArmCommands(unittest.TestCase):
         self.assertLess(worst[1].distance, distance, f"/{ns}: link {worst[0]} is {worst[1].distance * 1000:.1f} mm off")
         self.assertLess(turned[1].angle, angle, f"/{ns}: link {turned[0]} is turned {turned[1].angle:.4f} rad off")
 
+    def paused_until(self, done, what, timeout=30):
+        """With the physics paused: run it in unpause-pause round trips until ``done()`` (asked while paused)."""
+        def round_trip():
+            if done():
+                return True
+            self.unpause()
+            self.pause()
+            return False
+        wait_for(round_trip, timeout, what)
+
     def joint_states(self, ns):
         """{joint: position} from a /<ns>/joint_states message stamped at or after the simulator's sim time now
         (the newest this node holds may be older on a busy machine)."""
@@ -188,10 +198,9 @@ class ArmCommands(unittest.TestCase):
         try:  # read right after the impulse: run the physics in unpause-pause round trips, read while paused
             start = sim_now()
             resp = self.effort("eff_joint", torque, rospy.Time(0), rospy.Duration.from_sec(seconds))
-            wait_for(lambda: sim_now() >= start + seconds + 0.05 or (self.unpause(), self.pause()) and False, 30,
-                     "the effort's duration to pass")
+            self.paused_until(lambda: sim_now() >= start + seconds + 0.05, "the effort's duration to pass")
             t1, first = sim_now(), self.rate("eff_joint")
-            wait_for(lambda: sim_now() >= t1 + 0.2 or (self.unpause(), self.pause()) and False, 30, "0.2 s more")
+            self.paused_until(lambda: sim_now() >= t1 + 0.2, "0.2 s more")
             t2, second = sim_now(), self.rate("eff_joint")
         finally:
             self.unpause()
@@ -209,8 +218,7 @@ class ArmCommands(unittest.TestCase):
         self.pause()
         try:
             self.effort("eff_joint", 0.0005, rospy.Time(0), rospy.Duration(-1))
-            wait_for(lambda: self.rate("eff_joint") > 0.1 or (self.unpause(), self.pause()) and False, 30,
-                     "eff_joint speeding up")
+            self.paused_until(lambda: self.rate("eff_joint") > 0.1, "eff_joint speeding up")
             self.clear("eff_joint")
             cleared = self.rate("eff_joint")
         finally:

@@ -38,7 +38,8 @@ class ArmInterfaces(unittest.TestCase):
         tool = arm.world_pose("link_3")[0]
         sim_sleep(3.0, timeout=60)  # holds for 3 s of the simulator's sim time
         later = arm.world_pose("link_3")[0]
-        self.assertLess(math.dist(tool, later), 0.005, f"{name}: the stretched arm sagged {math.dist(tool, later):.4f} m")
+        self.assertLess(math.dist(tool, later), 0.005,
+                        f"{name}: the stretched arm sagged {math.dist(tool, later):.4f} m")
         return arm
 
     def test_position_with_pid_gains(self):

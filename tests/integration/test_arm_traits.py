@@ -28,8 +28,15 @@ import rospy
 import rostest
 from actionlib_msgs.msg import GoalStatus
 from control_msgs.msg import GripperCommandAction, GripperCommandGoal
-from gazebo_msgs.srv import (ApplyBodyWrench, ApplyJointEffort, DeleteModel, GetPhysicsProperties, GetWorldProperties,
-                             JointRequest, SetPhysicsProperties)
+from gazebo_msgs.srv import (
+    ApplyBodyWrench,
+    ApplyJointEffort,
+    DeleteModel,
+    GetPhysicsProperties,
+    GetWorldProperties,
+    JointRequest,
+    SetPhysicsProperties,
+)
 from geometry_msgs.msg import Point, Wrench
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64, Float64MultiArray
@@ -210,7 +217,7 @@ class ArmTraits(unittest.TestCase):
             self.assertTrue(resp.success, resp.status_message)
         pace(1.0 / physics.time_step)
         self.addCleanup(pace, physics.max_update_rate)
-        for attempt in range(3):  # a round trip longer than the 0.7 s the goal takes ends it first: again
+        for _attempt in range(3):  # a round trip longer than the 0.7 s the goal takes ends it first: again
             self.grip(ns, 0.01, 15.0)
             pause()
             try:

@@ -17,8 +17,7 @@ import unittest
 import rospy
 import rostest
 from actionlib_msgs.msg import GoalStatus
-from control_msgs.msg import FollowJointTrajectoryResult as Result
-from control_msgs.msg import JointTrajectoryControllerState
+from control_msgs.msg import FollowJointTrajectoryResult as Result, JointTrajectoryControllerState
 from control_msgs.srv import QueryTrajectoryState
 from controller_manager_msgs.srv import ListControllers
 from geometry_msgs.msg import Twist

@@ -19,6 +19,7 @@ from laser_geometry import LaserProjection
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan, Range
 from simtest import wait_for
+from stillness import held_still
 
 SIM = "/bullet_sim"
 LASER_IN_FOOTPRINT = (0.05, 0.0, 0.113)  # base_footprint -> base_link 0.033 up, base_link -> laser (0.05, 0, 0.08)
@@ -31,7 +32,7 @@ PILLAR = (0.5, 1.2, 0.2)
 
 GRAZE = 0.005  # m: a beam this close to an edge (a wall's end, the pillar's silhouette) may go either way
 TURN = 1.0  # rad the body turns left between the two scans compared
-REST_SPEED = 0.005  # m/s and rad/s: the body's ground-truth twist below this is at rest
+REST_BAND, REST_WINDOW = 0.001, 0.3  # m and rad, s of sim time: the body held within this band this long is at rest
 
 
 def expected_range(ox, oy, angle, rmax):
@@ -179,8 +180,9 @@ class LaserTest(unittest.TestCase):
                         f"scan periods off the 5 Hz grid: {gaps}")
         self.assertGreaterEqual(np.mean(np.round(periods) == 1), 0.8, f"too many scans missing: {gaps}")
 
-        # at the spawn pose
-        scan, sonar, pose = self.settled_scan(t0 + 0.5)
+        # at the spawn pose, once the body holds still (ground truth), not at a fixed time after the first scan
+        rest = self.wait(self.at_rest, 60, "the body at rest at its spawn pose (ground truth)")
+        scan, sonar, pose = self.settled_scan(rest.header.stamp.to_sec())
         laser, yaw, pillar = self.check_geometry(scan, pose, "at spawn")
         angles = scan.angle_min + np.arange(360) * scan.angle_increment
         # REP 103: the pillar (to the robot's left) is at a positive angle, about +67 deg
@@ -227,11 +229,17 @@ class LaserTest(unittest.TestCase):
         self.fail(f"timed out after {timeout} s waiting for {what}")
 
     def at_rest(self):
-        """The newest ground truth when it shows the body still (its twist), else None."""
-        msg = self.last(self.truth)
-        twist = msg.twist.twist
-        still = max(abs(twist.linear.x), abs(twist.linear.y), abs(twist.angular.z)) < REST_SPEED
-        return msg if still else None
+        """The newest ground truth once the body has held still over the last REST_WINDOW s of its stamps (its
+        position within REST_BAND m and its yaw within REST_BAND rad: stillness.held_still), else None. One
+        message with a low twist is an instant, which a body rocking to rest also passes."""
+        with self.lock:
+            truth = list(self.truth)
+        if not truth:
+            return None
+        heading = yaw_of(truth[-1].pose.pose.orientation)  # yaws taken about the last one: no jump at +-pi
+        samples = [(m.header.stamp.to_sec(), [m.pose.pose.position.x, m.pose.pose.position.y, m.pose.pose.position.z,
+                                              wrap(yaw_of(m.pose.pose.orientation) - heading)]) for m in truth]
+        return truth[-1] if held_still(samples, REST_BAND, REST_WINDOW)[0] else None
 
     def check_projection(self, scan, pose):
         """laser_geometry's point cloud (in the laser frame), moved to the world by the known pose, lies on

@@ -16,10 +16,12 @@ import rospy
 import rostest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
-from simtest import wait_for
+from simtest import sim_now, wait_for
+from stillness import held_still
 
 SIM = "/bullet_sim"
 SPEED, SECONDS, TOLERANCE = 0.3, 7.0, 0.02
+REST_BAND, REST_WINDOW = 0.001, 0.3  # m, s of sim time: a body whose position stays within this band is at rest
 
 
 class WorldWallsTest(unittest.TestCase):
@@ -29,18 +31,31 @@ class WorldWallsTest(unittest.TestCase):
         cls.lanes = rospy.get_param("~lanes")
         cls.lock = threading.Lock()
         cls.truth = {}
+        cls.history = {}  # name -> [(stamp, [x, y, z])], the last 2 s or so of ground truth
         cls.subs, cls.pubs = [], {}
         for lane in cls.lanes:
             name = lane["robot"]
             cls.subs.append(rospy.Subscriber(f"{SIM}/{name}/ground_truth", Odometry, cls._keep,
-                                             callback_args=name, queue_size=1))
+                                             callback_args=name, queue_size=100))
             cls.pubs[name] = rospy.Publisher(f"/{name}/cmd_vel", Twist, queue_size=1)
 
     @classmethod
     def _keep(cls, msg, name):
+        p = msg.pose.pose.position
         with cls.lock:
-            cls.truth[name] = msg.pose.pose.position
-            cls.stamp = msg.header.stamp.to_sec()
+            cls.truth[name] = p
+            kept = cls.history.setdefault(name, [])
+            kept.append((msg.header.stamp.to_sec(), [p.x, p.y, p.z]))
+            del kept[:-500]
+
+    def at_rest(self, names, since):
+        """{name: position} once every robot's ground truth, stamped at or after ``since``, has held within
+        REST_BAND over the last REST_WINDOW s of its stamps (stillness.held_still); else None."""
+        with self.lock:
+            history = {n: [s for s in self.history.get(n, []) if s[0] >= since] for n in names}
+            if all(held_still(history[n], REST_BAND, REST_WINDOW)[0] for n in names):
+                return {n: self.truth[n] for n in names}
+        return None
 
     def wait(self, predicate, timeout, what):
         return wait_for(predicate, timeout, what, 0.01)
@@ -50,8 +65,9 @@ class WorldWallsTest(unittest.TestCase):
         names = [lane["robot"] for lane in self.lanes if "z" not in lane]
         self.wait(lambda: all(n in self.truth for n in every), 60.0, "every robot's ground truth")
         self.wait(lambda: all(self.pubs[n].get_num_connections() > 0 for n in names), 30.0, "the cmd_vel subscribers")
-        rospy.sleep(1.0)  # sim time: a robot dropped from a height has landed
-        start = {n: self.truth[n].x for n in every}
+        # every robot at rest (one dropped from a height has landed), judged by its ground truth's stamps
+        rest = self.wait(lambda: self.at_rest(every, -1.0), 60.0, "every robot at rest before the drive")
+        start = {n: rest[n].x for n in every}
         for name in every:
             self.assertAlmostEqual(start[name], 0.0, delta=0.02, msg=f"{name} did not start at x = 0")
         msg = Twist()
@@ -63,6 +79,10 @@ class WorldWallsTest(unittest.TestCase):
             rospy.sleep(0.05)
         for name in names:
             self.pubs[name].publish(Twist())
+        # where each robot ended: ground truth stamped after the stop (the newest this node holds may be older)
+        stopped = sim_now()
+        self.wait(lambda: all(self.history.get(n) and self.history[n][-1][0] >= stopped for n in every), 30.0,
+                  "ground truth stamped after the stop")
         with self.lock:
             final = {n: self.truth[n].x for n in every}
             heights = {n: self.truth[n].z for n in every}

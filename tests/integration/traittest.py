@@ -15,11 +15,11 @@ from controller_manager_msgs.srv import ListControllers, LoadController, SwitchC
 from gazebo_msgs.srv import GetLinkState, GetModelState, GetWorldProperties, SpawnModel
 from geometry_msgs.msg import Pose
 from rosgraph_msgs.msg import Log
+from simtest import wait_for
 from std_srvs.srv import Empty
 
 from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.transforms import compose, inverse, rpy_quaternion
-from simtest import wait_for
 
 STRICT = 2
 
