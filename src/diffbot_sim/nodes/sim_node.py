@@ -25,7 +25,7 @@ import rospy
 from diffbot_sim import config as cfgmod
 from diffbot_sim import streams
 from diffbot_sim.errors import DiffbotSimError
-from diffbot_sim.simulator import robots
+from diffbot_sim.simulator import link_attacher, robots
 
 
 def _own_the_clock():
@@ -78,6 +78,8 @@ def _main():
             rospy.set_param("/use_sim_time", True)  # as gazebo_ros: later nodes follow /clock
         if cfg.enable_ros_network:
             sim.api = robots.world_api(sim, cfg, params)
+            if sim.api is not None and sim.world_description is not None:  # the world plugin it simulates
+                sim.link_attacher = link_attacher.start_if_named(sim, sim.world_description.source)
         sim.advertise_services()
         sim.run()
     finally:

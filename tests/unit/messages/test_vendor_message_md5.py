@@ -6,7 +6,7 @@ a Kobuki's event listeners or a link-attacher caller connects here only with ups
 UPSTREAM_MD5 was computed with ``genmsg.compute_md5`` from the files of each pinned upstream commit (named in
 each package's README.md), exported to a temporary directory, with Debian's /usr/share/<pkg>/msg for the
 standard dependencies; FourWheelSteeringStamped's value also appears in code others generated from the real
-package (rosserial, genlisp, gennodejs), and so do BumperEvent's. An .action is first expanded by Debian's
+package (rosserial, genlisp, gennodejs), and so do BumperEvent's and Attach's. An .action is first expanded by Debian's
 actionlib_msgs genaction.py (what catkin's add_action_files runs) into its seven messages.
 """
 import glob
@@ -46,6 +46,7 @@ UPSTREAM_MD5 = {
     "kobuki_msgs/Sound": "dfeab0daae67749c426c1db741a4f420",
     "kobuki_msgs/VersionInfo": "3dc0ce6edd49be1fc86730f4a4a21861",
     "kobuki_msgs/WheelDropEvent": "e102837d89384d67669a0df86b63f33b",
+    "gazebo_ros_link_attacher/Attach": "c91fb3be70ce66d19130d40294cf4bd5",
 }
 PACKAGES = sorted({name.split("/")[0] for name in UPSTREAM_MD5})
 GENACTION = "/usr/lib/actionlib_msgs/genaction.py"
