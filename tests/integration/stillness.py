@@ -6,6 +6,7 @@ command is a guess about how long settling takes on this machine. ``held_still``
 stamps (sim time, as the simulator stamped them), so a test node that reads them late judges the same window.
 Pure: no ROS; the suites feed it what their callbacks kept.
 """
+import math
 
 
 def held_still(samples, band, window):
@@ -26,3 +27,25 @@ def held_still(samples, band, window):
     if widest is not None and spreads[widest] > band:
         return False, f"value {widest} moved {spreads[widest]:.5f} over the last {window} s (band {band})"
     return True, list(samples[-1][1])
+
+
+def pose_values(pose, heading=0.0):
+    """[x, y, z, roll, pitch, yaw] of a geometry_msgs Pose for ``held_still``, the yaw taken about ``heading``
+    (the last sample's: no jump where it wraps at +-pi; angles rather than quaternion components, which a
+    publisher may flip in sign)."""
+    p, q = pose.position, pose.orientation
+    roll = math.atan2(2.0 * (q.w * q.x + q.y * q.z), 1.0 - 2.0 * (q.x * q.x + q.y * q.y))
+    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (q.w * q.y - q.z * q.x))))
+    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    return [p.x, p.y, p.z, roll, pitch, math.remainder(yaw - heading, 2.0 * math.pi)]
+
+
+def pose_still(messages, band, window):
+    """The last of ``messages`` (stamped, with ``.pose.pose``: nav_msgs/Odometry, as ground truth comes) when
+    the body's position (m) and orientation (rad) have held within ``band`` over the last ``window`` s of their
+    stamps (``held_still``), else None."""
+    if not messages:
+        return None
+    heading = pose_values(messages[-1].pose.pose)[5]
+    samples = [(m.header.stamp.to_sec(), pose_values(m.pose.pose, heading)) for m in messages]
+    return messages[-1] if held_still(samples, band, window)[0] else None

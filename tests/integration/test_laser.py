@@ -19,7 +19,7 @@ from laser_geometry import LaserProjection
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan, Range
 from simtest import wait_for
-from stillness import held_still
+from stillness import pose_still
 
 SIM = "/bullet_sim"
 LASER_IN_FOOTPRINT = (0.05, 0.0, 0.113)  # base_footprint -> base_link 0.033 up, base_link -> laser (0.05, 0, 0.08)
@@ -230,16 +230,11 @@ class LaserTest(unittest.TestCase):
 
     def at_rest(self):
         """The newest ground truth once the body has held still over the last REST_WINDOW s of its stamps (its
-        position within REST_BAND m and its yaw within REST_BAND rad: stillness.held_still), else None. One
-        message with a low twist is an instant, which a body rocking to rest also passes."""
+        position within REST_BAND m and its orientation within REST_BAND rad: stillness.pose_still), else None.
+        One message with a low twist is an instant, which a body rocking to rest also passes."""
         with self.lock:
             truth = list(self.truth)
-        if not truth:
-            return None
-        heading = yaw_of(truth[-1].pose.pose.orientation)  # yaws taken about the last one: no jump at +-pi
-        samples = [(m.header.stamp.to_sec(), [m.pose.pose.position.x, m.pose.pose.position.y, m.pose.pose.position.z,
-                                              wrap(yaw_of(m.pose.pose.orientation) - heading)]) for m in truth]
-        return truth[-1] if held_still(samples, REST_BAND, REST_WINDOW)[0] else None
+        return pose_still(truth, REST_BAND, REST_WINDOW)
 
     def check_projection(self, scan, pose):
         """laser_geometry's point cloud (in the laser frame), moved to the world by the known pose, lies on

@@ -30,7 +30,7 @@ import rostest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu
-from simtest import wait_for
+from simtest import sim_now, wait_for
 from std_srvs.srv import Empty
 
 from diffbot_sim.check import drive_check
@@ -59,11 +59,13 @@ class Latest:
         self.msg = None
         self.count = 0
         self.samples = [] if keep else None
+        self.msgs = [] if keep else None
 
     def __call__(self, msg):
         with self.lock:
             self.msg, self.count = msg, self.count + 1
             if self.samples is not None:
+                self.msgs.append(msg)
                 p, q = msg.pose.pose.position, msg.pose.pose.orientation
                 self.samples.append(drive_check.body_sample(msg.header.stamp.to_sec(), (p.x, p.y, p.z),
                                                             (q.x, q.y, q.z, q.w)))
@@ -71,6 +73,11 @@ class Latest:
     def get(self):
         with self.lock:
             return self.msg
+
+    def first_after(self, stamp):
+        """The first message kept that is stamped at or after ``stamp`` (sim time), else None."""
+        with self.lock:
+            return next((m for m in self.msgs if m.header.stamp.to_sec() >= stamp), None)
 
     def between(self, start, end):
         """The body samples stamped in [start, end] (sim time)."""
@@ -83,36 +90,39 @@ class RealRobotTest(unittest.TestCase):
     def setUpClass(cls):
         rospy.init_node("test_real_robot")
         cls.cmd_topic = rospy.get_param("~cmd_topic")
-        cls.odom = Latest()
+        cls.odom = Latest(keep=True)
         cls.truth = Latest(keep=True)
-        cls.truth_sub = rospy.Subscriber(SIM + "/ground_truth", Odometry, cls.truth, queue_size=100)
-        cls.subs = [rospy.Subscriber(rospy.get_param("~odom_topic"), Odometry, cls.odom, queue_size=1),
+        # every message kept, however late this node reads them: a run's ends are found by their stamps
+        cls.truth_sub = rospy.Subscriber(SIM + "/ground_truth", Odometry, cls.truth, queue_size=1000)
+        cls.subs = [rospy.Subscriber(rospy.get_param("~odom_topic"), Odometry, cls.odom, queue_size=1000),
                     cls.truth_sub]
         cls.pub = rospy.Publisher(cls.cmd_topic, Twist, queue_size=1)
         cls.imu = Latest()
         if rospy.has_param("~imu_topic"):
             cls.subs.append(rospy.Subscriber(rospy.get_param("~imu_topic"), Imu, cls.imu, queue_size=1))
 
-    def wait(self, predicate, timeout, what):
-        return wait_for(predicate, timeout, what, 0.005)
+    def wait(self, predicate, timeout, what, poll=0.005):
+        return wait_for(predicate, timeout, what, poll)
 
     def drive(self, linear, angular, seconds, lateral=0.0):
-        """Command (linear, angular) at 20 Hz of sim time for ``seconds``; returns (odom, truth) at start and
-        end, and the body samples in between. The measured run starts once the command has been on for RAMP s
-        of sim time: faster than real time, a busy machine delays this node's first command by wall time, which
-        would cost the run sim seconds the robot never had its command for."""
+        """Command (linear, angular) at 20 Hz of sim time; returns (odom, truth) at the start and the end of a
+        run of ``seconds`` of sim time, and the body samples in between. The run starts once the command has been
+        on for RAMP s of sim time (faster than real time, a busy machine delays this node's first command by wall
+        time, which would cost the run sim seconds the robot never had its command for), and its two ends are
+        the first messages stamped at or after them: the newest message this node holds at a moment of its
+        clock can be half a second of sim time old on a busy machine, and more at one end than the other."""
         msg = Twist()
         msg.linear.x, msg.linear.y, msg.angular.z = linear, lateral, angular
-        ramp_end = rospy.get_time() + RAMP
-        while rospy.get_time() < ramp_end:
+        begin = sim_now() + RAMP
+        end_at = begin + seconds
+
+        def run_done():
             self.pub.publish(msg)
-            rospy.sleep(0.05)
-        start = (self.odom.get(), self.truth.get())
-        end_time = rospy.get_time() + seconds
-        while rospy.get_time() < end_time:
-            self.pub.publish(msg)
-            rospy.sleep(0.05)
-        end = (self.odom.get(), self.truth.get())
+            return self.odom.first_after(end_at) is not None and self.truth.first_after(end_at) is not None
+        self.wait(run_done, 60.0 + 10.0 * (RAMP + seconds), f"a run of {seconds} s of sim time from {begin:.3f}",
+                  poll=0.01)  # wall: a command at least every 0.03 s of sim time at 3x real time
+        start = (self.odom.first_after(begin), self.truth.first_after(begin))
+        end = (self.odom.first_after(end_at), self.truth.first_after(end_at))
         self.pub.publish(Twist())
         return start, end, self.truth.between(start[1].header.stamp.to_sec(), end[1].header.stamp.to_sec())
 

@@ -18,6 +18,7 @@ from geometry_msgs.msg import Twist, Vector3Stamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, NavSatFix
 from simtest import wait_for
+from stillness import pose_still
 
 from diffbot_sim.plugins.gps import radii
 from diffbot_sim.transforms import yaw_from_quaternion
@@ -25,7 +26,7 @@ from diffbot_sim.transforms import yaw_from_quaternion
 SIM = "/bullet_sim"
 G = 9.81
 MOTION_TIMEOUT = 60.0  # s wall: a motion of a few sim seconds (at 3x real time), on a 4x slower machine
-REST_SPEED = 0.005  # m/s and rad/s: the body's ground-truth twist below this is at rest
+REST_BAND, REST_WINDOW = 0.001, 0.3  # m and rad, s of sim time: the body held within this band this long is at rest
 DRIVE = 0.6  # m of each straight drive (0.2 m/s for 3 s)
 TURN = math.pi / 2  # rad of the turn in place (0.5 rad/s for pi s)
 
@@ -99,10 +100,12 @@ class SensorImuTest(unittest.TestCase):
         self.fail(f"timed out after {MOTION_TIMEOUT} s waiting for {what}")
 
     def still(self):
-        """The newest ground truth when it shows the body still, else None."""
-        truth = self.truth()
-        v, w = truth.twist.twist.linear, truth.twist.twist.angular
-        return truth if max(abs(v.x), abs(v.y), abs(w.z)) < REST_SPEED else None
+        """The newest ground truth once the body has held still over the last REST_WINDOW s of its stamps (its
+        position within REST_BAND m and its orientation within REST_BAND rad: stillness.pose_still), else None.
+        One message with a low twist is an instant, which a body bouncing or rocking to rest also passes."""
+        with self.rec[SIM + "/ground_truth"].lock:
+            truth = self.rec[SIM + "/ground_truth"].msgs[-200:]
+        return pose_still(truth, REST_BAND, REST_WINDOW)
 
     def at_rest(self, what):
         """Stop, and wait until the body is still (ground truth) and a GPS fix taken since has come: returns
