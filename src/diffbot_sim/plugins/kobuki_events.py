@@ -10,19 +10,11 @@ logs and goes on. The decisions are :mod:`diffbot_sim.sensors.kobuki_events`.
 """
 from diffbot_sim.plugins.base import join
 from diffbot_sim.plugins.bumper import ContactSensor
+from diffbot_sim.plugins.sensor_lookup import find_sensor
 from diffbot_sim.sensors import kobuki_events as ev
 from diffbot_sim.sensors import ray as ray_sensor
 from diffbot_sim.transforms import yaw_from_quaternion
 from diffbot_sim.values import tag_number
-
-
-def find_sensor(model, name):
-    """(element, link, path) of the model's ``<sensor name=...>``, or None."""
-    for block in model.gazebo:
-        for el in block.element.iter("sensor"):
-            if el.get("name") == name:
-                return el, block.reference, f"{block.path}/sensor[@name='{name}']"
-    return None
 
 
 class CliffSensor:

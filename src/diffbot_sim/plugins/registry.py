@@ -20,6 +20,7 @@ from diffbot_sim.plugins import (
     p3d,
     planar_move,
     ray_clouds,
+    realsense,
     ros_control,
     skid_steer,
 )
@@ -47,6 +48,7 @@ MODEL_PLUGINS = {
     "libroboticsgroup_gazebo_mimic_joint_plugin.so": mimic_joint.create,
     "libroboticsgroup_upatras_gazebo_mimic_joint_plugin.so": mimic_joint.create,
     "libgazebo_ros_ft_sensor.so": force_torque.create_model,
+    "librealsense_gazebo_plugin.so": realsense.create,
 }
 #: Sensor plugins by filename: ``create(ctx, sensor, plugin_element, params)`` with ``sensor`` a
 #: :class:`~diffbot_sim.description.plugin_tags.SensorElement` (its type, link, element and path). One line per module.
