@@ -12,7 +12,6 @@ cmd_vel, odom in its plugin's robotNamespace).
 import math
 import os
 import sys
-import time
 import unittest
 
 import rosgraph
@@ -197,7 +196,10 @@ class GazeboApiTest(unittest.TestCase):
         wait(lambda: not publishers_of("/bot_del/odom"), 10.0, "/bot_del/odom unregistered")
         count = odom.count
         pub.publish(cmd)
-        time.sleep(0.5)  # observing that nothing arrives: a bounded look, not a wait for a condition
+        # observing that nothing arrives, for 0.5 s of the simulator's time (25 odom messages, were it still
+        # publishing), not of this node's wall clock, which a busy machine can give it little of
+        looked_from = self.world().sim_time
+        wait(lambda: self.world().sim_time >= looked_from + 0.5, 10.0, "0.5 s of sim time after the delete")
         self.assertLessEqual(odom.count, count + 1)
         again = self.delete("bot_del")
         self.assertFalse(again.success)

@@ -11,6 +11,7 @@ as one step of the command says), at well above real time.
 """
 import math
 import sys
+import threading
 import time
 import unittest
 
@@ -29,12 +30,40 @@ SCAN_PERIOD = 0.2  # s: laser_robot.urdf's 5 Hz laser
 STEPS = 30
 
 
+class Track:
+    """The ground truth's (stamp, x, y) since the last reset_simulation (the callback only stores): a stamp lower
+    than the one before is the reset, and starts the list anew, so messages from before a reset that this node
+    reads after it are never taken for the body after it."""
+
+    def __init__(self, topic="/bullet_sim/ground_truth"):
+        self.lock = threading.Lock()
+        self.samples, self.resets = [], 0
+        self.sub = rospy.Subscriber(topic, Odometry, self._keep, queue_size=1000)
+
+    def _keep(self, msg):
+        stamp, p = msg.header.stamp.to_sec(), msg.pose.pose.position
+        with self.lock:
+            if self.samples and stamp < self.samples[-1][0]:
+                self.samples, self.resets = [], self.resets + 1
+            self.samples.append((stamp, p.x, p.y))
+
+    def at(self, stamp, resets):
+        """(x, y) of the body at sim time ``stamp`` (the last sample stamped at or before it), once a sample
+        stamped at or after it has come after the ``resets``-th reset."""
+        def known():
+            with self.lock:
+                if self.resets < resets or not self.samples or self.samples[-1][0] < stamp:
+                    return None
+                return next(s for s in reversed(self.samples) if s[0] <= stamp + 1e-9)[1:]
+        return wait_for(known, 30, f"ground truth at {stamp:.3f} s of sim time (after reset {resets})")
+
+
 class Lockstep(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         rospy.init_node("test_lockstep")
         cls.cmd = rospy.Publisher("/cmd_vel", Twist, queue_size=5)
-        cls.truth = Latest("/bullet_sim/ground_truth", Odometry)
+        cls.truth = Track()
         cls.states = Latest("/gazebo/model_states", ModelStates)
         for name in ("reset_simulation", "spawn_sdf_model", "delete_model"):
             rospy.wait_for_service(f"/gazebo/{name}", 30)
@@ -72,16 +101,18 @@ class Lockstep(unittest.TestCase):
         """Ten steps of 0.2 m/s, then two of 0: the body (ground truth) moved 10 periods' worth, 0.4 m, less what
         starting from rest costs (measured at real time: 0.37 m); held longer per step, it goes further (0.67 m
         without ~wait_for_nodes)."""
+        resets = self.truth.resets + 1
         self.reset()
-        rospy.wait_for_message("/scan", LaserScan, timeout=30)
-        wait_for(lambda: self.truth.get() is not None, 10, "ground truth")
-        start = self.truth.get().pose.pose.position
+        first = rospy.wait_for_message("/scan", LaserScan, timeout=30).header.stamp.to_sec()
+        # the body where each scan was taken (its stamp), not the newest ground truth this node has read: that
+        # can be a step old, or from before the reset
+        start = self.truth.at(first, resets)
         for _ in range(10):
             self.step(0.0, 0.03, linear=0.2)
         self.step(0.0, 0.0)
-        self.step(0.0, 0.0)
-        end = self.truth.get().pose.pose.position
-        moved = math.hypot(end.x - start.x, end.y - start.y)
+        last = self.step(0.0, 0.0)
+        end = self.truth.at(last, resets)
+        moved = math.dist(end, start)
         self.assertAlmostEqual(moved, 0.37, delta=0.03, msg=f"the body moved {moved:.3f} m in 10 steps of 0.2 m/s")
 
     def test_3_goal_marker_spawned_and_deleted_while_held(self):

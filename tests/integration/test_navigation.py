@@ -28,7 +28,7 @@ from geometry_msgs.msg import PoseWithCovarianceStamped
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from rosgraph_msgs.msg import Clock, Log
 from sensor_msgs.msg import LaserScan
-from simtest import TfEdges, Truth, figure, wait_for
+from simtest import TfEdges, Truth, figure, sim_now, wait_for
 
 from diffbot_sim.check.drive_check import wrap
 
@@ -170,7 +170,10 @@ class NavigationTest(unittest.TestCase):
             self.assertTrue(wait_for(ended, timeout * 3 + 60, f"the goal ({x}, {y})"))
             state = self.client.get_state()
             took, wall = rospy.get_time() - started, time.monotonic() - wall_started
-            body = wait_for(lambda: (s := self.truth.last()) is not None and s.t >= rospy.get_time() - 0.2 and s,
+            # the body after the goal ended: ground truth stamped at or after the simulator's time now (this
+            # node's clock, and the newest sample it holds, can be half a second of sim time behind)
+            ended_at = sim_now()
+            body = wait_for(lambda: (s := self.truth.last()) is not None and s.t >= ended_at and s,
                             30.0, "the ground truth after the goal")
             error, yaw_error = math.hypot(body.x - x, body.y - y), abs(wrap(body.yaw - yaw))
             belief = self.rec.amcl_xy()
