@@ -64,6 +64,10 @@ VARIANTS = {v.filename: v for v in (
             "ridgeback/ridgeback_simulator noetic-devel ridgeback_ros_force_based_move.cpp", 0.25),
     Variant("libnexus_ros_force_based_move.so",
             "RBinsonB/nexus_4wd_mecanum_simulator nexus_ros_force_based_move.cpp", 0.25),
+    # Robotnik's copy (Summit XL, RB-Kairos): its <commandWatchdog>, which freezes the base's pose once expired,
+    # is not read (one unknown-tag warning): the base coasts to rest under the P loop instead
+    Variant("librobotnik_force_based_move.so",
+            "RobotnikAutomation/robotnik_gazebo_plugins robotnik_force_based_move.cpp", None),
 )}
 
 

@@ -6,6 +6,7 @@ PluginBlocks; every other one from its element by its module's ``create(ctx, ele
 from diffbot_sim.description.plugin_tags import DIFF_DRIVE, JOINT_STATE, plugin_filename
 from diffbot_sim.errors import PluginNotLoaded
 from diffbot_sim.plugins import (
+    body_force,
     bumper,
     diff_drive,
     force_based_move,
@@ -23,6 +24,7 @@ from diffbot_sim.plugins import (
     realsense,
     ros_control,
     skid_steer,
+    sonar,
 )
 from diffbot_sim.plugins.camera import create as create_camera
 from diffbot_sim.plugins.depth import create as create_depth
@@ -49,6 +51,10 @@ MODEL_PLUGINS = {
     "libroboticsgroup_upatras_gazebo_mimic_joint_plugin.so": mimic_joint.create,
     "libgazebo_ros_ft_sensor.so": force_torque.create_model,
     "librealsense_gazebo_plugin.so": realsense.create,
+    # aliases: the same plugins under their other published names
+    "librobotnik_force_based_move.so": force_based_move.create,  # Robotnik's copy of the force-based move
+    "libgazebo_mimic_joint_plugin.so": mimic_joint.create,  # the mimic plugin's ROS 2 port (and its first name)
+    "libgazebo_ros_force.so": body_force.create,
 }
 #: Sensor plugins by filename: ``create(ctx, sensor, plugin_element, params)`` with ``sensor`` a
 #: :class:`~diffbot_sim.description.plugin_tags.SensorElement` (its type, link, element and path). One line per module.
@@ -66,6 +72,8 @@ SENSOR_PLUGINS = {
     "libgazebo_ros_bumper.so": bumper.create,
     "libgazebo_ros_multicamera.so": multicamera.create,
     "libgazebo_ros_ft_sensor.so": force_torque.create_sensor,
+    "libgazebo_ros_depth_camera.so": create_depth,  # gazebo_ros_depth_camera: openni_kinect's tags and topics
+    "libhector_gazebo_ros_sonar.so": sonar.create,
 }
 #: Every filename simulated (the rest are named once as not simulated).
 KNOWN = (DIFF_DRIVE, JOINT_STATE) + tuple(MODEL_PLUGINS)
