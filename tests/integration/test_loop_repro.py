@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""loop_repro suite (issue 27, item 3): in lockstep, the same scenario with the same seed gives the same
+"""loop_repro suite: in lockstep, the same scenario with the same seed gives the same
 trajectory, whatever the wall time of the client's work and whatever else runs on the machine.
 
 The client is written as Gazebo learning environments are (TurtleBot3's machine-learning chapter): ``step``

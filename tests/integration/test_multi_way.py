@@ -3,7 +3,7 @@
 multi_turtlebot3.launch shape, three TurtleBot3-class robots in a furnished house made of meshes).
 
 Each robot's plugins take the spawning node's namespace (``/tb3_N/``; spawn_model has no -robot_namespace)
-and name their frames as Noetic's gazebo_ros does (fleets_and_actors.md B.3-B.6):
+and name their frames as Noetic's gazebo_ros does (its plugins' tf_prefix lookup since gazebo_ros_pkgs #1173):
 
 * ``~prefixed`` false (multi_tb3like.launch, robot_state_publisher's tf_prefix private): the plugins find no
   tf_prefix, so odometry is ``odom -> base_footprint`` and scans are in ``base_scan`` for every robot, while

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Resets and spawns without leaks (slow_resets.test; issue 27, item 2): what a Gazebo learning environment does
+"""Resets and spawns without leaks (slow_resets.test): what a Gazebo learning environment does
 over thousands of episodes (TurtleBot3's machine-learning chapter: /gazebo/reset_simulation, then the goal marker
 deleted and spawned again), made 10,000 times against the simulator in fast mode, each call through a plain
 ``rospy.ServiceProxy`` as such code makes it (a master lookup and a new connection per call).

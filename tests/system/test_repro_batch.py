@@ -1,4 +1,4 @@
-"""Reproducible in lockstep (issue 27, item 3): the same scenario with the same seed gives the same trajectory, run
+"""Reproducible in lockstep: the same scenario with the same seed gives the same trajectory, run
 after run, alone or among 8 parallel batch runs.
 
 The scenario is tests/rostest/loop_repro.test (a Gazebo-style step-and-wait client driving the laser robot with

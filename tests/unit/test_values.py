@@ -1,4 +1,4 @@
-"""tag_values: numbers in Gazebo tags read as Gazebo reads them (std::stod / std::stoul: the leading number,
+"""values: numbers in Gazebo tags read as Gazebo reads them (std::stod / std::stoul: the leading number,
 the rest dropped) with one warning naming the tag; a text with no leading number is still an error."""
 import math
 

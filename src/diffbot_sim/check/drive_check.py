@@ -32,7 +32,8 @@ TRUTH_TURN_FRACTION = 0.5  # of TURN * SECONDS: the least the body itself must t
 SKID_TURN_FRACTION = 0.25  # the same for a skid-steered body (more than one wheel a side: its wheels slide)
 MAX_TURN_DRIFT = 0.1  # m the body's origin may move while turning in place
 #: fraction of the command: how closely a base whose plugin imposes its velocity (planar_move, the force-based
-#: move family) follows it, straight, sideways and turning, by ground truth (issue 30's fixtures)
+#: move family) follows it, straight, sideways and turning, by ground truth (the fixtures planar_steered_casters and
+#: force_based_mecanum reach it)
 HOLONOMIC_TOLERANCE = 0.05
 #: Plugins (bullet_sim's ``~plugins`` names them) that move a body sideways too, so its drive test strafes.
 HOLONOMIC_PLUGINS = ("libgazebo_ros_planar_move.so", "libgazebo_ros_force_based_move.so",

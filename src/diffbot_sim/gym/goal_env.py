@@ -1,7 +1,7 @@
 """``GoalEnv``: drive a robot to a goal in a world without touching anything (Gymnasium 1.x API, in-process).
 
 The task is the one of TurtleBot3's machine-learning chapter (ROBOTIS-GIT/turtlebot3_machine_learning,
-noetic ``src/turtlebot3_dqn/environment_stage_1.py``; facts in shared/reference/loop_and_learning.md part B),
+noetic ``src/turtlebot3_dqn/environment_stage_1.py``),
 simulated here without Gazebo or ROS, for speed and repeatability:
 
 Observation (``Box``, float32), in this order:

@@ -1,5 +1,5 @@
 """``libhector_gazebo_ros_gps.so``: sensor_msgs/NavSatFix and geometry_msgs/Vector3Stamped (velocity) of a
-link, as hector_gazebo_plugins' GazeboRosGps gives them (sensors.md §5).
+link, as hector_gazebo_plugins' GazeboRosGps gives them (``gazebo_ros_gps.cpp``).
 
 Tags and defaults: ``bodyName`` (the model's first link; a lumped link works too), ``frameId`` (``world``;
 hector's default ``/world`` loses its slash, which tf2 rejects), ``topicName`` (``fix``),

@@ -6,9 +6,10 @@ angular velocity and proper acceleration (+g on an upward z at rest) in the moun
 or not, moved by the sensor's SDF ``<pose>``). The acceleration is the finite difference of the frame
 origin's world velocity over the publishing period. Deviations of the originals that are corrected here:
 ``gazebo_ros_imu`` reads no gravity (≈0 at rest, gazebo_ros_pkgs #468) and rotates rates and accelerations
-body→world instead of world→body (#344).
+body→world instead of world→body (gazebo_ros_pkgs #344).
 
-Tags and defaults (sensors.md §3, §5):
+Tags and defaults (gazebo_plugins' ``gazebo_ros_imu.cpp`` and ``gazebo_ros_imu_sensor.cpp``, hector_gazebo_plugins'
+``gazebo_ros_imu.cpp``):
 
 * ``gazebo_ros_imu_sensor`` ROS 1: ``robotNamespace``, ``topicName`` (``imu_data``), ``frameName``
   (required), ``updateRateHZ`` (1 Hz, with a warning; the SDF ``<update_rate>`` caps it),

@@ -1,5 +1,5 @@
 """``libgazebo_ros_p3d.so``: nav_msgs/Odometry of a body (a URDF link, lumped or not) in the world or in
-another link's frame, as gazebo_plugins' GazeboRosP3D publishes it (sensors.md §5).
+another link's frame, as gazebo_plugins' GazeboRosP3D publishes it (``gazebo_ros_p3d.cpp``).
 
 Tags: ``bodyName`` and ``topicName`` (both required), ``frameName`` (``world``; a link name makes pose and
 twist relative to that link), ``xyzOffset``/``rpyOffset`` (the position is shifted and the orientation

@@ -1,6 +1,6 @@
 """``libgazebo_ros_range.so`` (ROS 1, on a ``<sensor type="ray">``): sonar and IR rangers -> sensor_msgs/Range.
 
-As gazebo_ros_range does (sensors.md §5): ``range`` is the minimum over all the sensor's raw rays (its h x v
+As gazebo_plugins' ``gazebo_ros_range.cpp`` does: ``range`` is the minimum over all the sensor's raw rays (its h x v
 samples make the cone; ``fov`` is only published), a ray without a hit counting as ``range_max``; Gaussian
 noise (``gaussianNoise``, mean 0) only when that minimum is below ``range_max``, then at most ``range_max``.
 So no return reads ``range_max``, never inf. The SDF ``<ray><noise>`` does not apply (the plugin reads the

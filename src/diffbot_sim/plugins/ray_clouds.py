@@ -3,7 +3,7 @@ and ``libgazebo_ros_velodyne_laser.so`` / ``libgazebo_ros_velodyne_gpu_laser.so`
 sensor_msgs/PointCloud2 with x, y, z, intensity, ring, time). Casting and range semantics are the laser's
 (:class:`diffbot_sim.plugins.ray_base.RaySensorPlugin`, :mod:`diffbot_sim.sensors.ray`).
 
-* Block laser (gazebo_ros_block_laser, sensors.md §1.2): tags ``robotNamespace``, ``topicName`` (``/world``),
+* Block laser (gazebo_plugins' ``gazebo_ros_block_laser.cpp``): tags ``robotNamespace``, ``topicName`` (``/world``),
   ``frameName``, ``gaussianNoise`` (0, on x, y, z of every finite point); ``hokuyoMinIntensity`` and
   ``updateRate`` are read by the original but never applied. One point per reading (Gazebo interpolates
   between the four nearest rays; at resolution 1, the usual case, that is the ray itself), a miss at +inf,

@@ -1,7 +1,8 @@
 """Gazebo's camera and depth sensors (``<sensor type="camera|depth">``) as pure logic: SDF and plugin-tag
 reading, CameraInfo as gazebo_ros computes it, the projection PyBullet needs, depth linearisation and the
 depth -> point-cloud conversion of ``gazebo_ros_openni_kinect`` (pure: numpy only; the rendering is
-``physics.World.render``). Facts and sources: /work/shared/reference/sensors.md §4, §6.2.
+``physics.World.render``). Sources: gazebo_ros_pkgs' gazebo_plugins (noetic) ``gazebo_ros_camera_utils.cpp`` and
+``gazebo_ros_openni_kinect.cpp``, and PyBullet's ``getCameraImage``.
 
 * Gazebo renders along the sensor's **+x** (y left, z up); the plugins publish in ``frameName`` as given and
   rotate nothing: a robot names a child ``*_optical_frame`` (rpy -pi/2 0 -pi/2) there itself.

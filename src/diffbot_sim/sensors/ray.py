@@ -1,7 +1,8 @@
 """Gazebo's ray sensor (``<sensor type="ray">`` / ``gpu_ray``) as pure logic: SDF reading, ray geometry and
 what Gazebo 7+ turns the hit distances into (pure: numpy only; the casting is ``physics.World.ray_batch``).
 
-What Gazebo does, and so what this does (facts and sources: /work/shared/reference/sensors.md §1-2):
+What Gazebo does, and so what this does (sources: gazebo_ros_pkgs' gazebo_plugins (noetic) ``gazebo_ros_laser.cpp``,
+gazebo-classic's ray sensor, sdformat's ``ray.sdf`` and ``noise.sdf``):
 
 * ``rangeCount = int(samples * resolution)`` per axis; ``angle_increment = (max - min) / (rangeCount - 1)``,
   so the first and last beams sit exactly on ``min_angle`` and ``max_angle``; beams go counter-clockwise

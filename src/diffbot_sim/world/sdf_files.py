@@ -21,8 +21,8 @@ VERSIONS = ((1, 4), (1, 5), (1, 6), (1, 7), (1, 8), (1, 9))
 PARSER_VERSION = VERSIONS[-1]
 
 # Gazebo installs exactly these two models with itself "to make Gazebo run without an internet
-# connection" (worlds.md 2.4). Written from the facts listed there: a static plane with ODE friction 100/50
-# and a directional light.
+# connection" (the comment of gazebo-classic's models/CMakeLists.txt). Written from gazebo_models'
+# ground_plane/model.sdf and sun/model.sdf: a static plane with ODE friction 100/50 and a directional light.
 BUILTIN_MODELS = {
     "ground_plane": """<sdf version="1.5"><model name="ground_plane"><static>true</static>
   <link name="link"><collision name="collision"><geometry><plane><normal>0 0 1</normal><size>100 100</size>

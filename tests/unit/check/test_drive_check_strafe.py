@@ -59,6 +59,6 @@ def test_a_tighter_tolerance_for_bases_that_impose_their_velocity():
     assert not drive_check.straight((0, 0, 0), (0.8, 0, 0), (0, 0, 0), (0.7, 0, 0), tolerance=tight).passed
     turn = dict(truth_fraction=1 - tight, odom_fraction=1 - tight, tolerance=tight)
     assert drive_check.turn((0, 0, 0), (0, 0, 2.0), (0, 0, 0), (0, 0, 1.96), **turn).passed
-    assert not drive_check.turn((0, 0, 0), (0, 0, 2.0), (0, 0, 0), (0, 0, 1.32), **turn).passed  # issue 30: 0.66
+    assert not drive_check.turn((0, 0, 0), (0, 0, 2.0), (0, 0, 0), (0, 0, 1.32), **turn).passed  # 0.66 of the turn
     assert not drive_check.turn((0, 0, 0), (0, 0, 2.0), (0, 0, 0), (0, 0, 2.2), **turn).passed
     assert drive_check.turn((0, 0, 0), (0, 0, 2.0), (0, 0, 0), (0, 0, 2.2)).passed

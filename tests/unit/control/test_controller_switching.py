@@ -1,4 +1,4 @@
-"""switching.py: controller_manager's load / switch / unload rules (what the spawner and the
+"""controller_switching: controller_manager's load / switch / unload rules (what the spawner and the
 controller_manager command rely on)."""
 import pytest
 

@@ -1,5 +1,5 @@
-"""tests/data/robots/mistakes.urdf, loaded the way bullet_sim loads a model (without ROS): every published
-mistake of real_robots.md section 3 is survived, those Gazebo warns about with exactly one line naming it, the
+"""tests/data/robots/mistakes.urdf, loaded the way bullet_sim loads a model (without ROS): every mistake found in
+published robots (listed in its header) is survived, those Gazebo warns about with exactly one line naming it, the
 ones Gazebo reads silently with none, and PyBullet loads the result with the URDF's mass."""
 import os
 

@@ -1,4 +1,4 @@
-"""description.py: xacro in-process with $(arg) mappings, errors naming the file, parse_args, mesh URIs."""
+"""description.model_files: xacro in-process with $(arg) mappings, errors naming the file, parse_args, mesh URIs."""
 import os
 
 import pytest

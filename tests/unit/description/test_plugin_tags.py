@@ -1,4 +1,4 @@
-"""plugins.py: the <gazebo><plugin> blocks in both dialects, as canonical raw values."""
+"""description.plugin_tags: the <gazebo><plugin> blocks in both dialects, as canonical raw values."""
 import os
 
 import pytest

@@ -1,4 +1,4 @@
-"""model.py: parsing the URDF (seed xacro and small hand-written ones), errors naming file/element,
+"""description.urdf_model: parsing the URDF (seed xacro and small hand-written ones), errors naming file/element,
 wheel geometry, and ros_control SimpleTransmission arithmetic."""
 import math
 

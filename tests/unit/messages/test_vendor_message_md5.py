@@ -1,4 +1,4 @@
-"""The vendor message packages of the overlay (issue 42) are their upstreams', md5 sum for md5 sum.
+"""The vendor message packages of the overlay are their upstreams', md5 sum for md5 sum.
 
 ROS 1 peers refuse a connection whose md5 sum differs, so a client of four_wheel_steering_controller,
 a Kobuki's event listeners or a link-attacher caller connects here only with upstream's definitions.

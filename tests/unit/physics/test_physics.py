@@ -1,4 +1,4 @@
-"""physics.py on PyBullet DIRECT: faithful mass, poses in the URDF link frame, REP 103 driving, passive
+"""physics (World, Robot) on PyBullet DIRECT: faithful mass, poses in the URDF link frame, REP 103 driving, passive
 casters, reset, independent worlds. Every test gets fresh worlds, closed by the fixture; runs are short."""
 import math
 import os

@@ -1,4 +1,4 @@
-"""camera_sensor (pure): SDF parsing with SDF defaults, CameraInfo as gazebo_ros computes it, PyBullet's
+"""sensors.camera (pure): SDF parsing with SDF defaults, CameraInfo as gazebo_ros computes it, PyBullet's
 vertical FOV, depth-buffer linearisation, the kinect plugin's point cloud and its byte layout."""
 import math
 import struct

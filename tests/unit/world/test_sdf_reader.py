@@ -1,8 +1,8 @@
-"""world_sdf.read_world: Gazebo-classic .world files (SDF 1.4-1.9) into WorldDescription, without PyBullet.
+"""world.sdf_reader.read_world: Gazebo-classic .world files (SDF 1.4-1.9) into WorldDescription, without PyBullet.
 
 Every fixture is written here into tmp_path (TurtleBot3-style world and model directories included), except
 the repository's own worlds/room.world. Poses are checked as (xyz, quaternion xyzw) in the world frame for
-bodies and in the link frame for shapes, as world.py defines them.
+bodies and in the link frame for shapes, as world.bodies defines them.
 """
 import math
 import os

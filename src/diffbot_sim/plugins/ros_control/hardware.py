@@ -2,7 +2,7 @@
 
 Each transmission joint with a Position, Velocity or Effort interface gets a command buffer (controllers
 write it), its joint limits (URDF ``<limit>`` and ``<safety_controller>``, then ``<ns>/joint_limits/<joint>``;
-:mod:`diffbot_sim.control.joint_limits`) and a control method (manipulators.md §1.5-1.6):
+:mod:`diffbot_sim.control.joint_limits`) and a control method (gazebo_ros_control's ``default_robot_hw_sim.cpp``):
 
 * EFFORT: the command, limited, as the joint's torque, every physics step (zero until commanded);
 * POSITION (no ``pid_gains``): Gazebo sets the joint's position (a kinematic set, clamped to its limits, the
