@@ -199,7 +199,8 @@ class MultiWayTest(unittest.TestCase):
                 wait(lambda: self.tf_buffer.can_transform("odom", "base_footprint", rospy.Time()), 20.0,
                      "the plugins' unprefixed odom -> base_footprint in TF")
                 self.assertFalse(self.tf_buffer._frameExists(f"{name}/odom"),
-                                 f"no {name}/odom on Noetic without a tf_prefix the plugins find (#214)")
+                                 f"no {name}/odom on Noetic without a tf_prefix the plugins find "
+                                 "(turtlebot3_simulations #214)")
                 continue
             t = wait(lambda: self.tf_buffer.can_transform(f"{name}/odom", f"{name}/base_scan", rospy.Time()) and
                      self.tf_buffer.lookup_transform(f"{name}/odom", f"{name}/base_scan", rospy.Time()),
