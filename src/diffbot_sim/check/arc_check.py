@@ -44,6 +44,22 @@ def axle_sample(t, base_xy, heading, base_velocity, yaw_rate, offset):
                       base_velocity[0] - yaw_rate * ry, base_velocity[1] + yaw_rate * rx)
 
 
+def axle_samples(poses, offset):
+    """AxleSamples of the point at ``offset`` (body frame) from body poses [(t, x, y, yaw)] alone (ground truth
+    without twists): positions, and velocities by differences of neighbouring samples."""
+    points = []
+    for t, x, y, yaw in poses:
+        c, s = math.cos(yaw), math.sin(yaw)
+        points.append((t, x + c * offset[0] - s * offset[1], y + s * offset[0] + c * offset[1], yaw))
+    out = []
+    for i, (t, x, y, yaw) in enumerate(points):
+        a, b = points[max(i - 1, 0)], points[min(i + 1, len(points) - 1)]
+        dt = b[0] - a[0]
+        out.append(AxleSample(t, x, y, yaw, (b[1] - a[1]) / dt if dt > 0 else 0.0,
+                              (b[2] - a[2]) / dt if dt > 0 else 0.0))
+    return out
+
+
 def geometry_radius(wheelbase, steer):
     """The rear axle's turning radius [m] of a bicycle model with ``wheelbase`` [m] steered by ``steer`` [rad]."""
     return math.inf if abs(math.tan(steer)) < 1e-12 else wheelbase / abs(math.tan(steer))

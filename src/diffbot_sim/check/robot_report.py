@@ -14,10 +14,14 @@ from dataclasses import dataclass, field
 from typing import List, Optional, Tuple
 
 from diffbot_sim import config as cfgmod
-from diffbot_sim.check import arm_report
+from diffbot_sim.check import arc_check, arm_report
 from diffbot_sim.check.drive_check import HOLONOMIC_PLUGINS
+from diffbot_sim.control import ackermann_steering_controller as asc
 from diffbot_sim.control import diff_drive_config as ddc
+from diffbot_sim.control import steer_bot_hardware as sbh
 from diffbot_sim.control.controller_lookup import find_controllers
+from diffbot_sim.control.four_wheel_steering_controller import joint_offset
+from diffbot_sim.description.gazebo_collisions import sensor_collision
 from diffbot_sim.description.plugin_tags import DIFF_DRIVE, JOINT_STATE
 from diffbot_sim.description.prepared_model import prepare_model, read_model_file
 from diffbot_sim.description.urdf_model import tag_value
@@ -52,6 +56,12 @@ class Drive:
     radius: Optional[float] = None  # m, as used (multiplier applied)
     radius_from: str = ""
     note: str = ""  # e.g. "holonomic: no wheels"
+    #: car-like (ackermann_steering_controller): the bicycle model's wheelbase [m], the rear axle's middle in the
+    #: root link's frame (x, y) and the turning radii its arc may have (None: L / tan δ exactly)
+    wheelbase: Optional[float] = None
+    steering: List[str] = field(default_factory=list)  # steering joints (a car's): neither wheels nor arm joints
+    rear_axle: Tuple[float, float] = (0.0, 0.0)
+    radius_range: Optional[Tuple[float, float]] = None
 
 
 @dataclass
@@ -83,6 +93,7 @@ class Report:
     model: object = None  # the parsed URDF (description.urdf_model.RobotModel)
     control_ns: str = "/"  # gazebo_ros_control's robotNamespace
     controllers: dict = field(default_factory=dict)  # {controller namespace: parameters} found under it
+    contacts: List[str] = field(default_factory=list)  # one line per contact sensor: its collision, its topics
 
     @property
     def arm_joints(self):
@@ -105,6 +116,11 @@ class Report:
     def drive(self):
         """The drive the simulator runs first (None: nothing moves the robot)."""
         return self.drives[0] if self.drives else None
+
+    @property
+    def car(self):
+        """True when the first drive steers (a car cannot turn in place: it is driven in an arc)."""
+        return self.drive is not None and self.drive.wheelbase is not None
 
 
 # ----------------------------------------------------------------------------------------- parameters
@@ -196,7 +212,11 @@ def build_report(path, model_args="", controller_files=(), known=(), known_senso
         elif other.filename == ROS_CONTROL:
             ns = values.get("robotNamespace") or "/"
             sim_type = values.get("robotSimType") or DEFAULT_SIM_TYPE
-            if sim_type != DEFAULT_SIM_TYPE:
+            steer_bot = None
+            if sim_type == sbh.SIM_TYPE:
+                found_ns = ns if _param(tree, f"{ns}/{sbh.PARAM_NS}") is not None else "/"  # as the plugin looks
+                steer_bot = (_param(tree, f"{found_ns}/{sbh.PARAM_NS}"), _param(tree, f"{found_ns}/gains"), found_ns)
+            elif sim_type != DEFAULT_SIM_TYPE:
                 warnings.append(f"{other.path}: robotSimType '{sim_type}' is not simulated; using {DEFAULT_SIM_TYPE}")
             warnings.extend(f"gazebo_ros_control: {skipped.warning}" for skipped in model.other_transmissions)
             controllers = find_controllers(tree, ns)
@@ -215,9 +235,14 @@ def build_report(path, model_args="", controller_files=(), known=(), known_senso
                     drive, notes = _ddc(model, name, params, file)
                     drives.append(drive)
                     warnings.extend(notes)
+                elif kind == asc.CONTROLLER_TYPE:
+                    drive, notes = _ackermann(model, name, params, file, steer_bot)
+                    drives.append(drive)
+                    warnings.extend(notes)
     for sensor in found.sensors:  # simulated when one of its plugins is (a bare <sensor> publishes nothing)
         items.append(Item("sensor", sensor.name or "?", sensor.type or "?", sensor.path,
                           any(p in known_sensors for p in sensor.plugins)))
+    contacts = _contact_lines(model, found)
     for blk in (found.diff_drive, found.joint_state):
         if blk is not None and blk.unknown_tags:
             warnings.append(f"{blk.path}: unknown tags ignored: {', '.join(blk.unknown_tags)}")
@@ -237,10 +262,86 @@ def build_report(path, model_args="", controller_files=(), known=(), known_senso
         warnings.append("not simulated (ignored): " + "; ".join(found.unsupported))
     if not drives:
         warnings.append(NO_DRIVE)
-    wheels = {joint for drive in drives for joint in drive.left + drive.right}
+    wheels = {joint for drive in drives for joint in drive.left + drive.right + drive.steering}
     joints = arm_report.joint_infos(model, tree, control_ns, control_controllers, wheels, mimics)
     return Report(source, model.name, model.total_mass(), loaded_mass, drives, items, _unique(warnings),
-                  rest_height, wheel_centre, footprint, joints, model, control_ns, control_controllers)
+                  rest_height, wheel_centre, footprint, joints, model, control_ns, control_controllers, contacts)
+
+
+def _param(tree, name):
+    """The value at parameter ``name`` of a merged parameter tree (nested dicts), or None."""
+    node = tree
+    for part in [p for p in name.split("/") if p]:
+        if not isinstance(node, dict) or part not in node:
+            return None
+        node = node[part]
+    return node
+
+
+def _ackermann(model, name, params, file, steer_bot):
+    """An AckermannSteeringController: a car-like drive (its bicycle model), and the warnings bullet_sim logs."""
+    cfg = asc.ackermann_config(params, name)
+    notes = list(cfg.warnings)
+    if cfg.unknown_keys:
+        notes.append(f"{name}: parameters AckermannSteeringController does not read, ignored: "
+                     f"{', '.join(cfg.unknown_keys)}")
+    joints = {j.name: (j.parent, j.child, j.xyz) for j in model.joints.values()}
+    if cfg.wheel_separation_h is None:
+        rear, steer = model.joint(cfg.rear_wheel, name).xyz, model.joint(cfg.front_steer, name).xyz
+        wheelbase, base_from = abs(rear[0] - steer[0]), f"measured: x of {cfg.rear_wheel} and {cfg.front_steer}"
+    else:
+        wheelbase, base_from = cfg.wheel_separation_h, f"{name}/wheel_separation_h in {file}"
+    wheelbase *= cfg.wheel_separation_h_multiplier
+    try:
+        offset = joint_offset(joints, cfg.rear_wheel, model.root)[:2]
+    except KeyError:
+        offset = (0.0, 0.0)
+    radius_range, hw = None, ""
+    if steer_bot is not None:
+        hw_cfg = sbh.steer_bot_config(*steer_bot)
+        right, left = (joints[j][2] for j in hw_cfg.virtual_front_steers)
+        track = math.dist(right[:2], left[:2])
+        radius_range = arc_check.front_wheel_radii(wheelbase, track, *sbh.linkage_angles(arc_check.ARC_STEER, hw_cfg))
+        hw = (f"; {sbh.SIM_TYPE} maps it onto {', '.join(hw_cfg.virtual_wheels)} and the linkage of "
+              f"{', '.join(hw_cfg.virtual_front_steers)}")
+    note = (f"car-like (bicycle model): rear wheel {cfg.rear_wheel}, steering {cfg.front_steer} (cmd_vel angular.z is "
+            f"the steering angle), wheelbase {wheelbase:.3f} m ({base_from}){hw}; driven in an arc, not turned in "
+            "place")
+    steering = [cfg.front_steer] + (list(hw_cfg.virtual_front_steers) if steer_bot is not None else [])
+    return Drive(asc.CONTROLLER_TYPE, f"{name} from {file}", [cfg.rear_wheel], [], note=note, wheelbase=wheelbase,
+                 steering=steering, rear_axle=offset, radius_range=radius_range), notes
+
+
+def _contact_lines(model, found):
+    """One line per contact sensor: the collision it watches (as Gazebo names it) and what publishes it."""
+    kobuki_names = {}
+    for other in found.others:
+        if other.filename == KOBUKI:
+            values = {child.tag: tag_value(child) for child in other.element}
+            for key, topic in (("bumper_name", "events/bumper"), ("wheel_drop_left_sensor_name", "events/wheel_drop"),
+                               ("wheel_drop_right_sensor_name", "events/wheel_drop")):
+                if values.get(key):
+                    kobuki_names[values[key].strip()] = topic
+    lines = []
+    for sensor in found.sensors:
+        if sensor.type != "contact":
+            continue
+        contact = sensor.element.find("contact")
+        named = tag_value(contact.find("collision")) if contact is not None and contact.find("collision") is not None \
+            else ""
+        collision, name = sensor_collision(model, sensor.link or model.root, named)
+        watched = f"collision {name}" + ("" if collision else " (no such collision: it reports nothing, as in Gazebo)")
+        topics = []
+        for plugin in sensor.element.findall("plugin"):
+            if (plugin.get("filename") or "").endswith("gazebo_ros_bumper.so"):
+                tags = {child.tag: tag_value(child) for child in plugin}
+                ns = (tags.get("robotNamespace") or "").strip().rstrip("/")
+                topics.append(f"{ns}/{tags.get('bumperTopicName') or 'bumper_states'} (gazebo_msgs/ContactsState)")
+        if sensor.name in kobuki_names:
+            topics.append(f"<base_prefix>/{kobuki_names[sensor.name]} (the Kobuki plugin's kobuki_msgs events)")
+        lines.append(f"  contact sensor {sensor.name}: {watched}; publishes " + (", ".join(topics) or "nothing "
+                                                                                  "(no plugin reads it)"))
+    return lines
 
 
 def _footprint(loaded, model, drive):
@@ -375,6 +476,9 @@ def format_report(report, extra_warnings=()):
         mark = "simulated    " if item.simulated else "NOT simulated"
         what = item.what if item.kind != "sensor" else f"type {item.what}"
         lines.append(f"  {mark}  {item.kind} {item.name} ({what}) {item.where}")
+    if report.contacts:
+        lines.append("contact sensors:")
+        lines.extend(report.contacts)
     lines.extend(arm_report.format_joints(report.joints))
     warnings = _unique(list(report.warnings) + list(extra_warnings))
     lines.append(f"warnings bullet_sim logs at start: {len(warnings) or 'none'}")

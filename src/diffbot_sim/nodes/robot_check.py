@@ -31,7 +31,7 @@ import threading
 import time
 
 from diffbot_sim import streams
-from diffbot_sim.check import drive_check, robot_report
+from diffbot_sim.check import arc_check, drive_check, robot_report
 from diffbot_sim.check.session import SIM, Session, SessionError
 from diffbot_sim.description.model_files import package_path
 from diffbot_sim.errors import DiffbotSimError, ModelError
@@ -292,6 +292,10 @@ def _drive(session, report):
             strafe_body = drive_check.ride(truth.take_span(), rest.height, "driving sideways")
             _command(pub, 0.0, 0.0, PAUSE)
             strafe = drive_check.strafe(start[0], end[0], start[1], end[1])
+        if report.car:  # a car cannot turn in place: an arc at a fixed steering angle, judged by arc_check
+            arc, arc_body = _arc(pub, truth, odom, report, rest)
+            _command(pub, 0.0, 0.0, PAUSE)
+            return _verdict(session, report, logged, rest, straight, straight_body, arc=(arc, arc_body))
         start = (odom.get(), truth.get())
         truth.start_span()
         _command(pub, 0.0, drive_check.TURN, drive_check.SECONDS)
@@ -310,10 +314,44 @@ def _drive(session, report):
     finally:
         for sub in subs:
             sub.unregister()
+    return _verdict(session, report, logged, rest, straight, straight_body, (turn, turn_body), (strafe, strafe_body))
+
+
+def _arc(pub, truth, odom, report, rest):
+    """Drive the car in an arc (arc_check.ARC_SPEED at arc_check.ARC_STEER, past the first second: the steering's
+    travel) and judge the rear axle's circle and slip by ground truth."""
+    _command(pub, arc_check.ARC_SPEED, arc_check.ARC_STEER, 1.0)
+    truth.start_span()
+    _command(pub, arc_check.ARC_SPEED, arc_check.ARC_STEER, arc_check.ARC_SECONDS - 1.0)
+    span = truth.take_span()
+    body = drive_check.ride(span, rest.height, "driving in an arc")
+    drive = report.drive
+    samples = arc_check.axle_samples([(s.t, s.x, s.y, s.yaw) for s in span], drive.rear_axle)
+    return arc_check.arc(samples, drive.wheelbase, arc_check.ARC_STEER, radius_range=drive.radius_range), body
+
+
+def _verdict(session, report, logged, rest, straight, straight_body, turned=(None, None), strafed=(None, None),
+             arc=None):
+    """Print the drive's judgements and return (passed, verdict)."""
+    (turn, turn_body), (strafe, strafe_body) = turned, strafed
     for line in robot_report.format_rest(rest):
         _say(line)
-    for line in robot_report.format_motions(straight, turn, straight_body, turn_body, strafe, strafe_body):
-        _say(line)
+    if arc is None:
+        for line in robot_report.format_motions(straight, turn, straight_body, turn_body, strafe, strafe_body):
+            _say(line)
+    else:
+        result, body = arc
+        for line in robot_report.format_motions(straight, None, straight_body):
+            _say(line)
+        gives = (f"{result.expected:.3f} m (L / tan {arc_check.ARC_STEER:g})" if report.drive.radius_range is None
+                 else "{:.3f}..{:.3f} m (its front wheels' angles)".format(*sorted(map(abs,
+                                                                                        report.drive.radius_range))))
+        _say(f"arc {arc_check.ARC_SPEED:g} m/s at steer {arc_check.ARC_STEER:g} rad x {arc_check.ARC_SECONDS:g} s: "
+             f"rear axle radius {result.radius:.3f} m (the geometry gives {gives}), slip up to "
+             f"{result.max_slip:.4f} rad, turned {result.turned:.2f} rad: {'PASS' if result.passed else 'FAIL'}")
+        for text in result.failures:
+            _say(f"  {text}")
+        turn, turn_body = result, body
     during = [w for w in session.sim_warnings() if w not in logged and w not in report.warnings]
     for text in during[:3]:
         _say(f"  bullet_sim warned while driving: {text}")
@@ -323,7 +361,7 @@ def _drive(session, report):
         return False, "the robot does not rest upright on the ground before driving (ground truth)"
     sideways_ok = strafe is None or (strafe.passed and strafe_body.passed)
     if straight.passed and turn.passed and straight_body.passed and turn_body.passed and sideways_ok:
-        return True, "the robot drives"
+        return True, "the robot drives" + (" (straight and in an arc)" if arc is not None else "")
     return False, "the robot does not drive as commanded"
 
 

@@ -50,11 +50,19 @@ class Handle:
 class SteerBotHWSim:
     """SteerBotHardwareGazebo on one robot: the same calls as :class:`.hardware.RobotHWSim`."""
 
+    #: writeSim has work every step (the wheels' speeds are set before each one)
+    busy = True
+
     def __init__(self, ctx, ns, warnings):
         self.ctx, self.ns, self.estop = ctx, ns, False
+        where = ns
+        if get_param(join(ns, sbh.PARAM_NS), None) is None and get_param(join("/", sbh.PARAM_NS), None) is not None:
+            where = "/"  # as the controllers are found anywhere when not under the namespace (robot_check loads at /)
+            warnings.append(f"{SIM_TYPE}: its parameters are at /{sbh.PARAM_NS}, not under {ns} where Gazebo reads "
+                            "them; used")
         try:
-            self.cfg = sbh.steer_bot_config(get_param(join(ns, sbh.PARAM_NS), None),
-                                            get_param(join(ns, "gains"), None), ns)
+            self.cfg = sbh.steer_bot_config(get_param(join(where, sbh.PARAM_NS), None),
+                                            get_param(join(where, "gains"), None), where)
         except ConfigError as err:
             raise PluginNotLoaded(f"{SIM_TYPE}: {err}; the hardware did not initialise (as in Gazebo: no "
                                   "controller manager)") from None
