@@ -45,7 +45,8 @@ READY_TEXT = b"we are ready"  # teleop_key's banner
 
 #: Runs inside the clean environment with the install space's Python: `driver.py MODEL CMD_TOPIC` waits for the
 #: simulator and the model's command subscriber, commands SPEED forward (again every 0.05 s wall, for a
-#: controller with a cmd_vel_timeout), and prints the body's pose after SETTLE and then WINDOW sim seconds.
+#: controller with a cmd_vel_timeout), and prints the body's pose after SETTLE and then WINDOW sim seconds (the
+#: simulator's, by the stamps of /gazebo/get_model_state's answers).
 DRIVER = f"""
 import json, sys, time
 import rosgraph
@@ -76,15 +77,18 @@ while cmd_vel.get_num_connections() == 0 or rospy.get_time() == 0.0:
     time.sleep(0.05)
 
 def pose():
+    # t: the simulator's sim time of the pose (the answer's stamp, as gazebo_ros stamps it), not this node's
+    # clock, which lags it by a varying amount on a busy machine
     state = model_state(model, "")
     p, q = state.pose.position, state.pose.orientation
-    return dict(ok=state.success, t=rospy.get_time(), x=p.x, y=p.y, z=p.z, qx=q.x, qy=q.y, qz=q.z, qw=q.w)
+    return dict(ok=state.success, t=state.header.stamp.to_sec(), x=p.x, y=p.y, z=p.z, qx=q.x, qy=q.y, qz=q.z,
+                qw=q.w)
 
-def drive(seconds):
+def drive(seconds):  # command SPEED until the simulator's sim time has gone seconds on (the poses' stamps)
     command = Twist()
     command.linear.x = {SPEED}
-    until = rospy.get_time() + seconds
-    while rospy.get_time() < until:
+    until = pose()["t"] + seconds
+    while pose()["t"] < until:
         cmd_vel.publish(command)
         time.sleep(0.05)
 
