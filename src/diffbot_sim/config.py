@@ -19,6 +19,11 @@ FALLBACK_JOINT_EFFORT = 100.0
 #: ``~ray_process: auto`` starts the ray process in real time once the ray sensors cast this many rays per sim
 #: second (about a tenth of a core here: 28 TurtleBot3 lasers of 360 beams at 5 Hz, or one 16-row 3D lidar).
 RAY_PROCESS_AUTO_RAYS = 50_000
+#: Bounds [s] of the physics step (``~time_step``, a world's ``max_step_size``, set_physics_properties).
+MIN_TIME_STEP, MAX_TIME_STEP = 1e-5, 0.05
+#: SDF's ``<physics><max_step_size>`` default: the step Gazebo runs a world file at that states none (its own
+#: empty.world among them), and the one published gains were tuned at.
+SDF_MAX_STEP_SIZE = 0.001
 
 
 @dataclass
@@ -28,7 +33,7 @@ class SimConfig:
     model: str = ""  # path of a .urdf or .urdf.xacro; empty: the robot_description parameter
     model_args: str = ""  # xacro arguments, "name:=value name2:=value2"
     gui: bool = False
-    time_step: float = 1.0 / 240.0  # s; measured: the fidelity targets hold at it (README)
+    time_step: float = 1.0 / 240.0  # s; without ~time_step: a world file's max_step_size (SDF's 0.001 if unstated)
     real_time: bool = True  # pace sim time to the wall clock; false: as fast as possible
     real_time_factor: float = 1.0  # sim seconds per wall second when real_time
     fast_batch: float = 0.005  # s (wall); fast mode sends messages in bursts this often; 0: one write each
@@ -201,7 +206,7 @@ def sim_config(params):
             cfg.ray_process = check_bool(name("ray_process"), cfg.ray_process)
         except ConfigError:
             raise ConfigError(name("ray_process"), cfg.ray_process, "true, false or auto") from None
-    cfg.time_step = check_number(name("time_step"), cfg.time_step, low=1e-5, high=0.05)
+    cfg.time_step = check_number(name("time_step"), cfg.time_step, low=MIN_TIME_STEP, high=MAX_TIME_STEP)
     cfg.real_time_factor = check_number(name("real_time_factor"), cfg.real_time_factor, low=1e-3)
     cfg.clock_rate = check_number(name("clock_rate"), cfg.clock_rate, low=1e-3)
     cfg.clock_max_wall_rate = check_number(name("clock_max_wall_rate"), cfg.clock_max_wall_rate, low=0.0)

@@ -250,7 +250,7 @@ class GazeboApiTest(unittest.TestCase):
     def test_08_physics_properties_pause_and_resets(self):
         physics = proxy("get_physics_properties", gsrv.GetPhysicsProperties)()
         self.assertTrue(physics.success)
-        self.assertAlmostEqual(physics.time_step, 1.0 / 240.0, places=9)
+        self.assertAlmostEqual(physics.time_step, 0.001, places=9)  # walls.world's <max_step_size>
         self.assertFalse(physics.pause)
         self.assertAlmostEqual(physics.gravity.z, -9.8, delta=0.02)
         set_physics = proxy("set_physics_properties", gsrv.SetPhysicsProperties)
@@ -258,12 +258,22 @@ class GazeboApiTest(unittest.TestCase):
                                                     gravity=Vector3(0.0, 0.0, -5.0), ode_config=physics.ode_config)
         self.assertTrue(set_physics(request).success)
         self.assertAlmostEqual(proxy("get_physics_properties", gsrv.GetPhysicsProperties)().gravity.z, -5.0)
-        request.gravity, request.time_step = physics.gravity, 0.001
+        # a new step at run time, as Gazebo takes one: sim time goes on from where it was, at the new step
+        request.gravity, request.time_step = physics.gravity, 0.002
+        t0 = self.world().sim_time
+        self.assertTrue(set_physics(request).success)
+        changed = proxy("get_physics_properties", gsrv.GetPhysicsProperties)()
+        self.assertAlmostEqual(changed.time_step, 0.002, places=9)
+        wait(lambda: self.world().sim_time > t0 + 0.2, 10.0, "sim time at the new step")
+        now = self.world().sim_time  # still on the 1 ms grid it was on: 2 ms steps from there
+        self.assertAlmostEqual(round(now / 0.001) * 0.001, now, places=6)
+        request.time_step = 1.0  # beyond the bounds of ~time_step
         refused = set_physics(request)
         self.assertFalse(refused.success)
         self.assertIn("time_step", refused.status_message)
         request.time_step = physics.time_step
         self.assertTrue(set_physics(request).success)
+        self.assertAlmostEqual(proxy("get_physics_properties", gsrv.GetPhysicsProperties)().time_step, 0.001, places=9)
         rospy.ServiceProxy(f"{GZ}/pause_physics", Empty)()
         self.assertTrue(proxy("get_physics_properties", gsrv.GetPhysicsProperties)().pause)
         t0 = self.world().sim_time

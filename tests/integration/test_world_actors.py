@@ -15,8 +15,9 @@ from geometry_msgs.msg import Pose
 from sensor_msgs.msg import LaserScan
 from simtest import wait_for
 
-LASER_X, LASER_Z = 0.0, 0.113  # laser_robot.urdf: the laser's frame over the robot's origin
+LASER_OFFSET = 0.05  # m: laser_robot.urdf's laser_link, ahead of the robot's origin (0.113 m up)
 NEAR_FACE = 1.75  # m: the walker's near face (x = 2.0 - half its 0.5 m width)
+CUBE_HALF = 0.15  # m: half the mover cube's side
 FIRST_FRAME = 1.0 / 30.0 + 0.02  # s: Gazebo's first actor frame (1/30 s), and the pairing's 0.02 s
 
 
@@ -58,9 +59,17 @@ class WorldActors(unittest.TestCase):
             with cls.lock:
                 cls.states.append((now, msg))
 
+    def laser_x(self):
+        """The laser's x [m] from the robot's ground truth (it stands at the origin facing +x)."""
+        robot = self.get_state("laser_robot", "")
+        self.assertTrue(robot.success, robot.status_message)
+        self.assertLess(abs(robot.pose.position.x), 0.01, "the robot is not where it was spawned")
+        return robot.pose.position.x + LASER_OFFSET
+
     def test_1_the_walker_is_a_model_and_the_laser_sees_it(self):
         state = self.get_state("walker", "")
         self.assertTrue(state.success, state.status_message)
+        laser_x = self.laser_x()
         seen = 0
         # A scan is paired with the walker's pose in the model_states this node received within 0.02 s of the
         # scan's stamp, by this node's clock: model_states have no stamp. A message received before this
@@ -82,8 +91,8 @@ class WorldActors(unittest.TestCase):
             self.assertAlmostEqual(pose.x, 2.0, delta=0.01, msg=f"at t={t:.3f} the walker is not on its path")
             if abs(pose.y) > 1.0:
                 continue
-            bearing = math.atan2(pose.y, NEAR_FACE - LASER_X)
-            want = (NEAR_FACE - LASER_X) / math.cos(bearing)
+            bearing = math.atan2(pose.y, NEAR_FACE - laser_x)
+            want = (NEAR_FACE - laser_x) / math.cos(bearing)
             got = range_at(scan, bearing)
             self.assertAlmostEqual(got, want, delta=0.05, msg=f"at t={t:.2f} the walker (y={pose.y:.2f}) is seen at "
                                    f"{got:.3f} m, its near face is at {want:.3f} m")
@@ -91,6 +100,7 @@ class WorldActors(unittest.TestCase):
         self.assertGreater(seen, 5, "too few scans with the walker in front of the laser")
 
     def test_2_a_model_moved_by_set_model_state_is_seen_where_it_was_set(self):
+        laser_x = self.laser_x()
         pub = rospy.Publisher("/gazebo/set_model_state", ModelState, queue_size=10)
         wait_for(lambda: pub.get_num_connections() > 0, 10, "set_model_state subscribed")
         rate = rospy.Rate(30)
@@ -103,12 +113,15 @@ class WorldActors(unittest.TestCase):
             msg.pose.orientation.w = 1.0
             pub.publish(msg)
             rate.sleep()
-            if k % 15 == 14:  # a scan after the last set: the cube's near face ~1.05 m along its bearing
+            if k % 15 == 14:  # a scan after the last set: the beam at the cube's centre hits its near face
                 t = rospy.get_time()
                 scan = wait_for(lambda: self.scans.after(t), 10, "a scan after the set")[0]
-                got = range_at(scan, math.atan2(msg.pose.position.y, msg.pose.position.x))
-                self.assertAlmostEqual(got, 1.2 - 0.15, delta=0.06, msg=f"the cube set at angle {angle:.2f} is "
-                                       f"seen at {got:.3f} m")
+                x, y = msg.pose.position.x, msg.pose.position.y
+                bearing = math.atan2(y, x - laser_x)
+                want = (x - CUBE_HALF - laser_x) / math.cos(bearing)
+                got = range_at(scan, bearing)
+                self.assertAlmostEqual(got, want, delta=0.06, msg=f"the cube set at angle {angle:.2f} is "
+                                       f"seen at {got:.3f} m, its near face at {want:.3f} m")
                 checked += 1
         self.assertGreaterEqual(checked, 5)
 

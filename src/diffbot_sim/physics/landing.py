@@ -36,6 +36,11 @@ class Landings:
         self.erp = min(1.0, LANDING_CORRECTION_RATE * time_step)
         self._landing = {}  # Robot -> [steps it has rested, steps left]
 
+    def set_time_step(self, time_step):
+        """The world's step changed: the landing contact ERP follows it."""
+        self.time_step = time_step
+        self.erp = min(1.0, LANDING_CORRECTION_RATE * time_step)
+
     def __contains__(self, robot):
         return robot in self._landing
 

@@ -129,10 +129,14 @@ class Robot:
         return [self.joint_index[name] for name in names]
 
     def total_mass(self):
-        """Mass [kg] PyBullet simulates, over every link (merged fixed links included)."""
+        """Mass [kg] PyBullet simulates, over every link (merged fixed links included). A base held fixed (a
+        robot joined to the world) reads 0 kg in PyBullet: its mass is the URDF's, of the links it carries."""
         count = pybullet.getNumJoints(self.body, physicsClientId=self.client)
-        return sum(pybullet.getDynamicsInfo(self.body, i, physicsClientId=self.client)[0]
-                   for i in range(-1, count))
+        mass = sum(pybullet.getDynamicsInfo(self.body, i, physicsClientId=self.client)[0] for i in range(count))
+        if self.model.fixed_to_world:
+            carried = [name for name, (carrier, _, _) in self.frames.items() if carrier == self.model.root]
+            return mass + sum(self.model.links[name].mass or 0.0 for name in carried or [self.model.root])
+        return mass + pybullet.getDynamicsInfo(self.body, -1, physicsClientId=self.client)[0]
 
     def smallest_inertia(self, index):
         """The smallest principal moment [kg·m^2] of joint ``index``'s child link (a bound on its inertia

@@ -24,6 +24,9 @@ from diffbot_sim.physics.landing import LANDING_MAX_TIME, Landings
 from diffbot_sim.physics.rays import RAY_BATCH_LIMIT
 from diffbot_sim.physics.robot import Robot
 
+#: PyBullet's default numSolverIterations (the installed client reports 50; Gazebo's ODE quickstep default too)
+SOLVER_ITERATIONS = 50
+
 # World, and the limits callers plan by: how long a robot may take to be set down, how many rays a call casts
 __all__ = ["LANDING_MAX_TIME", "RAY_BATCH_LIMIT", "World"]
 
@@ -51,6 +54,7 @@ class World:
         self.landing = Landings(self.client, time_step)  # the robots being set down (``robot in world.landing``)
         self.ray_threads = 0  # rayTestBatch's numThreads (0: Bullet's pool picks)
         self.steps = 0  # physics steps taken
+        self.solver_iterations = SOLVER_ITERATIONS
         self._boxes = []  # add_kinematic_box's bodies
         self._egl = None  # the EGL renderer plugin, once loaded (use_egl)
         self.ray_link = rays.RayProcessLink(keep=ray_process in (True, "later"))
@@ -155,11 +159,30 @@ class World:
         """Height [m] of the highest world surface at (x, y) (a ray from 100 m down), 0 when none."""
         return queries.top_at(self.client, x, y, ignore)
 
-    def step(self):
-        pybullet.stepSimulation(physicsClientId=self.client)
-        self.steps += 1
-        if self.landing:
-            self.landing.watch()
+    def step(self, count=1):
+        """``count`` physics steps, nothing else between them (what PyBullet's motors hold stays; torques and
+        external forces last one step, so the caller steps one at a time while it applies them). A robot
+        being set down is watched after each."""
+        client = self.client
+        for _ in range(count):
+            pybullet.stepSimulation(physicsClientId=client)
+            self.steps += 1
+            if self.landing:
+                self.landing.watch()
+
+    def set_solver_iterations(self, iterations):
+        """Bullet's constraint solver iterations per step (a world's ``<ode><solver><iters>``, Gazebo's
+        sor_pgs_iters)."""
+        self.solver_iterations = int(iterations)
+        pybullet.setPhysicsEngineParameter(numSolverIterations=self.solver_iterations, physicsClientId=self.client)
+
+    def set_time_step(self, time_step):
+        """The physics step [s] from the next step on (set_physics_properties)."""
+        self.time_step = time_step
+        pybullet.setTimeStep(time_step, physicsClientId=self.client)
+        self.landing.set_time_step(time_step)
+        for robot in self.robots:
+            robot.time_step, robot.landing_erp = time_step, self.landing.erp
 
     # -- rays: in place, or in the ray process (``ray_process``: the same answers, later in wall time) ----------
     def ray_batch(self, starts, ends):

@@ -16,6 +16,8 @@ from diffbot_sim.world.actor_script import ActorScript
 from diffbot_sim.world.actor_walk import ActorWalker, person_box, read_walker_config, upright_pose
 
 ACTOR_PLUGIN = "libActorPlugin.so"
+#: Where an actor's box waits, out of every ray's and body's way, before its script's first frame.
+PARKED = ((0.0, 0.0, -1.0e5), (0.0, 0.0, 0.0, 1.0))
 
 
 class Actor:
@@ -32,8 +34,16 @@ class Actor:
         else:
             self.script = ActorScript(description)
         self.pose = description.world_pose
-        self.uid = world.add_kinematic_box((self.size_x, self.size_y, self.size_z), self._box_pose())
+        self.uid = world.add_kinematic_box((self.size_x, self.size_y, self.size_z), self._body_pose())
         self._placed = self.pose
+
+    def _body_pose(self):
+        """Where the box goes: on the actor, except while a script waits for its first frame (the first 1/30 s):
+        Gazebo's actor stands at its ``<pose>`` until then, touching nothing (it has no body), and a box there
+        would shove what stands at that pose (at 1/240 s steps a robot at the origin was pushed 4.7 cm)."""
+        if self.script is not None and self.script.about_to_move:
+            return PARKED
+        return self._box_pose()
 
     def _box_pose(self):
         if self.walker is not None:
@@ -51,7 +61,7 @@ class Actor:
         else:
             self.pose = self.script.pose_at(now)
         if self.pose != self._placed:
-            self.world.move_body(self.uid, self._box_pose())
+            self.world.move_body(self.uid, self._body_pose())
             self._placed = self.pose
 
     def reset(self, now):
@@ -60,7 +70,7 @@ class Actor:
         else:
             self.script.reset(now)
         self.pose = self.description.world_pose
-        self.world.move_body(self.uid, self._box_pose())
+        self.world.move_body(self.uid, self._body_pose())
         self._placed = self.pose
 
     def set_pose(self, pose):

@@ -21,6 +21,7 @@ from gazebo_msgs import msg as gmsg
 from gazebo_msgs import srv as gsrv
 from std_srvs.srv import Empty
 
+from diffbot_sim.config import MAX_TIME_STEP, MIN_TIME_STEP
 from diffbot_sim.description import meshes
 from diffbot_sim.description.model_files import package_path
 from diffbot_sim.errors import DiffbotSimError
@@ -70,6 +71,10 @@ class GazeboApi:
         if self.model_states_pub.get_num_connections() or self.link_states_pub.get_num_connections():
             return self.sim.sim_time
         return math.inf
+
+    def busy(self):
+        """Wrenches or joint efforts are being applied: they last one step, so every step needs this API."""
+        return bool(len(self.wrenches) or len(self.joints.efforts))
 
     def before_step(self, now):
         """Wrenches and joint efforts due during the coming step (Gazebo's schedulers run at the time the step
@@ -387,7 +392,8 @@ class GazeboApi:
         def action():
             cfg = self.cfg
             values = world_api.physics_properties(cfg.time_step, cfg.real_time_factor, cfg.real_time,
-                                                  self.sim.paused, self.sim.world.gravity)
+                                                  self.sim.paused, self.sim.world.gravity,
+                                                  self.sim.world.solver_iterations)
             response.time_step = values["time_step"]
             response.pause = values["pause"]
             response.max_update_rate = values["max_update_rate"]
@@ -400,12 +406,17 @@ class GazeboApi:
     def _set_physics(self, req):
         def action():
             cfg = self.cfg
-            if req.time_step and abs(req.time_step - cfg.time_step) > 1e-12:
-                raise RequestError(f"SetPhysicsProperties: time_step {req.time_step:g} s: the step is fixed at "
-                                   f"start (~time_step, {cfg.time_step:g} s)")
             g = req.gravity
-            if not all(math.isfinite(v) for v in (g.x, g.y, g.z, req.max_update_rate)):
-                raise RequestError("SetPhysicsProperties: gravity and max_update_rate must be finite")
+            if not all(math.isfinite(v) for v in (g.x, g.y, g.z, req.max_update_rate, req.time_step)):
+                raise RequestError("SetPhysicsProperties: time_step, gravity and max_update_rate must be finite")
+            if req.time_step and not MIN_TIME_STEP <= req.time_step <= MAX_TIME_STEP:
+                raise RequestError(f"SetPhysicsProperties: time_step {req.time_step:g} s is outside "
+                                   f"[{MIN_TIME_STEP:g}, {MAX_TIME_STEP:g}] s")
+            if req.time_step and abs(req.time_step - cfg.time_step) > 1e-12:
+                self.sim.set_time_step(req.time_step)  # before the rate: Gazebo's pace is rate x step
+            iters = req.ode_config.sor_pgs_iters
+            if iters > 0 and iters != self.sim.world.solver_iterations:
+                self.sim.world.set_solver_iterations(iters)
             if abs(g.x) > 1e-12 or abs(g.y) > 1e-12:
                 rospy.logwarn(f"{self.ns}/set_physics_properties: horizontal gravity is not simulated")
             self.sim.world.set_gravity(g.z)

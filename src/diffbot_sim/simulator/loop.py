@@ -29,6 +29,14 @@ CALL_TIMEOUT = 60.0
 #: request, hand-over to the loop, reply), each a full interval late: at 5 ms, reset_simulation took
 #: 46-154 ms. See docs/performance.md for the figures at this value.
 GIL_SWITCH_INTERVAL = 0.0005
+#: At most this many physics steps run in one go with no Python in between (``Simulator._batch``): steps that
+#: no plugin, clock or service has work before. A bound on how long a request waits in fast mode.
+MAX_BATCH_STEPS = 100
+#: In real time, sim time that falls behind the wall clock by more than this many wall seconds (a spawn, a slow
+#: service, a busy machine) is not made up: pacing starts again from where the simulation is, as Gazebo's
+#: World::Step paces each step from the last (sim time never races ahead to catch up). Smaller lags (a late
+#: wake-up) are made up, so that RTF stays 1 on average.
+MAX_CATCH_UP = 0.05
 
 
 class RobotRuntime:
@@ -58,6 +66,10 @@ class RobotRuntime:
     def next_publish(self):
         """Sim time of this robot's next publication."""
         return min((p.next_publish() for p in self.plugins), default=math.inf)
+
+    def next_control(self):
+        """Sim time at which one of this robot's plugins has control work before a step."""
+        return min((p.next_control() for p in self.plugins), default=math.inf)
 
     def next_work(self):
         """Sim time of the next thing this robot must do (control or publishing)."""
@@ -91,6 +103,7 @@ class Simulator:
         self._requests = []
         self._requests_lock = threading.Lock()
         self.steps = 0
+        self._time_base, self._steps_base = 0.0, 0  # sim time at the step count where the step last changed
         self.world = World(cfg.time_step, cfg.gravity, gui=cfg.gui,
                            ray_process="later" if cfg.ray_process == "auto" else cfg.ray_process)
         self.clock_pub = publisher("/clock", Clock)
@@ -204,6 +217,7 @@ class Simulator:
         """gazebo_ros reset_simulation: as reset_world, and sim time back to 0 (/clock jumps back, as in
         Gazebo)."""
         self.steps = 0
+        self._time_base, self._steps_base = 0.0, 0
         self.next_clock = 0.0
         self._next_publish = 0.0
         self.reset_world()
@@ -248,7 +262,15 @@ class Simulator:
 
     @property
     def sim_time(self):
-        return self.steps * self.cfg.time_step
+        return self._time_base + (self.steps - self._steps_base) * self.cfg.time_step
+
+    def set_time_step(self, time_step):
+        """set_physics_properties' time_step: the physics step [s] from the next step on; sim time goes on from
+        where it is."""
+        self._time_base, self._steps_base = self.sim_time, self.steps
+        self.cfg.time_step = time_step
+        self.world.set_time_step(time_step)
+        self._rebase()
 
     def _rebase(self):
         """Re-anchor real-time pacing at the current sim time (after a pause or a start)."""
@@ -273,7 +295,6 @@ class Simulator:
     # -- the loop -----------------------------------------------------------------------------------
     def run(self):
         cfg = self.cfg
-        dt = cfg.time_step
         sys.setswitchinterval(GIL_SWITCH_INTERVAL)
         for runtime in self.robots:
             runtime.start(self.sim_time)
@@ -289,15 +310,17 @@ class Simulator:
                 self.wake.wait(0.1)
                 self.wake.clear()
                 continue
+            limit = MAX_BATCH_STEPS
             if cfg.real_time:
-                target = self.sim0 + (time.monotonic() - self.wall0) * cfg.real_time_factor
-                if self.sim_time + dt > target + 1e-9:
+                dt = cfg.time_step
+                limit, target = self._real_time_room(time.monotonic())
+                if limit == 0:
                     # Sleep until the next thing due, or until a command wakes us. Publishing and control,
                     # not stepping, set the wake rate, so CPU stays low.
                     due = min([self.next_clock] + [r.next_work() for r in self.robots])
                     # Wake at the step that reaches ``due`` (steps land on multiples of dt), not at ``due``
                     # itself: waking between steps would only find nothing to do and sleep again.
-                    step_at = math.ceil(due / dt - 1e-6) * dt
+                    step_at = self._step_reaching(due)
                     wait = (max(step_at, self.sim_time + dt) - target) / cfg.real_time_factor
                     if self.wake.wait(min(max(wait, 0.0), 0.1)):
                         self.wake.clear()
@@ -308,9 +331,42 @@ class Simulator:
                             for runtime in self.robots:
                                 runtime.before_step(self.sim_time)
                     continue
-            self._step_once()
+            self._step_once(limit)
 
-    def _step_once(self):
+    def _real_time_room(self, wall):
+        """In real time, at wall-clock ``wall``: (how many steps are due now, at most MAX_BATCH_STEPS; 0 to wait,
+        the sim time pacing wants). Sim time that fell behind by more than MAX_CATCH_UP wall seconds (a stall:
+        a spawn, a slow service, a busy machine) is not made up: pacing starts again from here (``_rebase``)."""
+        cfg, dt = self.cfg, self.cfg.time_step
+        target = self.sim0 + (wall - self.wall0) * cfg.real_time_factor
+        if target - self.sim_time > MAX_CATCH_UP * cfg.real_time_factor + dt:
+            self.wall0, self.sim0 = wall - dt / cfg.real_time_factor, self.sim_time
+            target = self.sim_time + dt
+        due = int((target - self.sim_time) / dt + 1e-9)
+        return max(0, min(MAX_BATCH_STEPS, due)), target
+
+    def _step_reaching(self, due):
+        """Sim time of the first step at or after sim time ``due``."""
+        dt = self.cfg.time_step
+        return self.sim_time + max(0, math.ceil((due - self.sim_time) / dt - 1e-6)) * dt
+
+    def _batch(self, limit):
+        """How many physics steps can run now with no Python in between: up to the first step at or after the
+        earliest work due (a plugin's control or publication, /clock, the world API's), at most ``limit``; one
+        while anything needs every step (a robot being set down, actors, wrenches or efforts being applied).
+        Gazebo's plugins run on every world update; ours say when their update has work (``next_control``,
+        ``next_publish``), so steps in between are PyBullet's alone: a 1 ms world costs what its physics
+        costs."""
+        if limit <= 1 or self.world.landing or self.actors is not None or (
+                self.api is not None and self.api.busy()):
+            return 1
+        due = min([self._next_publish] + [r.next_control() for r in self.robots])
+        if due == math.inf:
+            return limit
+        steps = math.ceil((due - self.sim_time) / self.cfg.time_step - 1e-6)
+        return max(1, min(limit, steps))
+
+    def _step_once(self, limit=1):
         now = self.sim_time
         for runtime in self.robots:
             runtime.before_step(now)
@@ -318,8 +374,9 @@ class Simulator:
             self.actors.before_step(now)
         if self.api is not None:
             self.api.before_step(now)
-        self.world.step()
-        self.steps += 1
+        count = self._batch(limit)
+        self.world.step(count)
+        self.steps += count
         now = self.sim_time
         if now + 1e-9 < self._next_publish:
             if self.links.held_since is not None:
@@ -401,7 +458,7 @@ class Simulator:
 
     def stamp(self):
         """Sim time as a rospy.Time, via integer nanoseconds (cheaper than Time.from_sec's float path)."""
-        secs, nsecs = divmod(round(self.steps * self.cfg.time_step * 1e9), 1_000_000_000)
+        secs, nsecs = divmod(round(self.sim_time * 1e9), 1_000_000_000)
         return rospy.Time(secs, nsecs)
 
     def _publish_clock(self, now, wall=None):

@@ -11,6 +11,7 @@ from diffbot_sim.description import meshes
 from diffbot_sim.description.prepared_model import prepare_model, read_model_file
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ModelError
+from diffbot_sim.values import check_number
 from diffbot_sim.physics.robot_loading import place_robot
 from diffbot_sim.plugins import registry
 from diffbot_sim.plugins.base import RobotContext, get_param
@@ -108,12 +109,21 @@ def _read_world(cfg):
 
 
 def apply_world_physics(cfg, world, params):
-    """A world's gravity and pace apply unless the node's parameters set them; its step does not (ours is the
-    measured one; ``~time_step`` chooses another).
+    """A world's ``<physics>`` applies unless the node's parameters set the same: its step (``max_step_size``;
+    a Gazebo world that states none runs at SDF's default, 1 ms, as in Gazebo, where published gains were
+    tuned; ``~time_step`` chooses another), its gravity and its pace.
 
     The pace is Gazebo's: ``real_time_update_rate`` 0 runs as fast as the nodes in the loop allow (fast mode,
     ``~wait_for_nodes``); a rate r paces sim time to r x ``max_step_size`` (default 0.001 s) times the wall
     clock; without a rate, ``real_time_factor`` is taken as that factor."""
+    if "time_step" not in params:
+        step = world.max_step_size or (cfgmod.SDF_MAX_STEP_SIZE if world.sdf else None)
+        if step is not None:
+            cfg.time_step = check_number(f"{world.source}: <physics><max_step_size>", step,
+                                         low=cfgmod.MIN_TIME_STEP, high=cfgmod.MAX_TIME_STEP)
+    elif world.max_step_size and abs(world.max_step_size - cfg.time_step) > 1e-12:
+        world.not_simulated.append(f"physics max_step_size {world.max_step_size:g} s (~time_step sets the step: "
+                                   f"{cfg.time_step:g} s)")
     if "gravity" not in params and world.gravity is not None:
         cfg.gravity = world.gravity[2]
         if abs(world.gravity[0]) > 1e-9 or abs(world.gravity[1]) > 1e-9:
@@ -123,12 +133,9 @@ def apply_world_physics(cfg, world, params):
         cfg.real_time = rate > 0
     if "real_time_factor" not in params:
         if rate:
-            cfg.real_time_factor = rate * (world.max_step_size or 0.001)
+            cfg.real_time_factor = rate * (world.max_step_size or cfgmod.SDF_MAX_STEP_SIZE)
         elif world.real_time_factor:
             cfg.real_time_factor = world.real_time_factor
-    if world.max_step_size:
-        world.not_simulated.append(f"physics max_step_size {world.max_step_size:g} s (the step is ~time_step, "
-                                   f"{cfg.time_step:g} s)")
 
 
 def build(cfg, params):
@@ -140,6 +147,8 @@ def build(cfg, params):
         apply_world_physics(cfg, world, params)
     sim = Simulator(cfg)
     try:
+        if world is not None and world.solver_iterations:
+            sim.world.set_solver_iterations(world.solver_iterations)
         if cfg.renderer == "egl":  # before any body exists: the EGL plugin draws only bodies made after it
             reason = sim.world.use_egl()
             if reason is not None:

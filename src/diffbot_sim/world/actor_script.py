@@ -67,6 +67,14 @@ class ActorScript:
         self._held = self.initial_pose
         #: Time into the current trajectory of the last frame drawn, s.
         self.script_time = 0.0
+        self.drawn = False  # a frame has been drawn since the reset
+
+    @property
+    def about_to_move(self):
+        """Playing from its start with no delay, but before its first frame (1/30 s into the run): the actor
+        stands at its ``<pose>`` only until then (often the world's origin, where a robot is spawned)."""
+        return (self.active and self._moves and not self.drawn
+                and self.description.script.delay_start <= 0.0)
 
     def play(self, sim_time):
         """Actor::Play: (re)start the script at ``sim_time`` (what a plugin does when auto_start is false)."""
@@ -122,6 +130,7 @@ class ActorScript:
             return self._held
         start, _, track = segment
         self._prev_frame = sim_time
+        self.drawn = True
         self.script_time = script_time - start
         if track is not None:
             self._held = track.pose_at(self.script_time)

@@ -65,8 +65,9 @@ class Body:
 class WorldDescription:
     """Everything a world file asks of the simulator.
 
-    ``gravity`` m/s^2 (vector); ``real_time_factor`` and ``max_step_size`` from ``<physics>`` (None when the
-    file gives none); ``not_simulated``: lights, scene, GUI camera, plugins, other ``<physics>`` settings,
+    ``gravity`` m/s^2 (vector); ``real_time_factor``, ``real_time_update_rate``, ``max_step_size`` and
+    ``solver_iterations`` from ``<physics>`` (None when the file gives none; ``sdf`` True: a Gazebo world,
+    whose unstated ones are SDF's defaults); ``not_simulated``: lights, scene, GUI camera, plugins, other ``<physics>`` settings,
     named once at start; ``warnings``: one line each (unknown geometry skipped, missing mesh skipped...).
     """
 
@@ -77,7 +78,9 @@ class WorldDescription:
     real_time_factor: Optional[float] = None
     real_time_update_rate: Optional[float] = None  # Hz of world updates; 0: as fast as possible
     max_step_size: Optional[float] = None
+    solver_iterations: Optional[int] = None  # <physics><ode><solver><iters>
     not_simulated: List[str] = field(default_factory=list)
     warnings: List[str] = field(default_factory=list)
     has_ground: bool = False  # a ground plane is among the bodies (else the simulator adds its own)
     actors: List[object] = field(default_factory=list)  # world.actor_sdf.ActorDescription, in file order
+    sdf: bool = False  # an SDF world file (not a map_server map): SDF's <physics> defaults apply

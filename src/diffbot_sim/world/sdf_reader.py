@@ -25,8 +25,8 @@ What is read (SDF 1.4 to 1.9, as Gazebo 11 reads them):
 directories ROS packages export to gazebo_ros (:func:`ros_package_model_paths`); the first match wins.
 Gazebo's own ``ground_plane`` and ``sun`` are built in for when no directory has them. Nothing is ever
 downloaded: a model that cannot be found is an error that names every directory searched. (Finding and
-parsing the files: :mod:`diffbot_sim.world.sdf_files`.) What stays here is what shares one scope of names:
-models, links, frames and joints resolved against each other (``relative_to``, ``::``), and ``<state>``.
+parsing the files: :mod:`diffbot_sim.world.sdf_files`; resolving the frames: :mod:`diffbot_sim.world.sdf_frames`.)
+What stays here is reading the elements into that graph, ``<state>``, and the bodies it gives.
 """
 import os
 
@@ -37,6 +37,7 @@ from diffbot_sim.world.bodies import IDENTITY, Body, WorldDescription
 from diffbot_sim.world.model_paths import env_model_paths
 from diffbot_sim.world.sdf_elements import ElementReader, sdf_bool, text_of
 from diffbot_sim.world.sdf_files import BUILTIN_MODELS, SdfFiles
+from diffbot_sim.world.sdf_frames import FrameGraph, Scope, SdfLink, SdfModel
 
 # World children that change nothing our physics does: named once in ``not_simulated``.
 _WORLD_NOT_SIMULATED = ("scene", "gui", "atmosphere", "magnetic_field", "spherical_coordinates", "wind",
@@ -50,47 +51,6 @@ def _clean(pose):
     return (tuple(tidy(v) for v in p), tuple(tidy(v) for v in q))
 
 
-# ------------------------------------------------------------------------------------------ tree nodes
-
-class _Scope:
-    """A frame scope: the world or one model. Names in ``relative_to`` are looked up here."""
-
-    def __init__(self, name, full, parent):
-        self.name = name
-        self.full = full
-        self.parent = parent
-        self.links = {}
-        self.models = {}
-        self.frames = {}  # name -> (pose, relative_to, attached_to, path)
-        self.joints = {}  # name -> (pose, relative_to, child)
-
-
-class _Model(_Scope):
-    def __init__(self, name, full, parent, src, path):
-        super().__init__(name, full, parent)
-        self.src = src
-        self.path = path
-        self.static = False
-        self.pose = IDENTITY
-        self.relative_to = ""
-        self.placement = ""
-
-
-class _Link:
-    def __init__(self, name, model, src, path):
-        self.name = name
-        self.model = model
-        self.src = src
-        self.path = path
-        self.pose = IDENTITY
-        self.relative_to = ""
-        self.shapes = []
-        self.mass = 1.0
-        self.inertia = (1.0, 1.0, 1.0, 0.0, 0.0, 0.0)
-        self.inertial_pose = IDENTITY
-        self.color = None
-
-
 # ------------------------------------------------------------------------------------------ the reader
 
 class _Reader:
@@ -100,10 +60,8 @@ class _Reader:
         self.world = None
         self.stack = []  # files being included, to catch include cycles
         self.top = []  # the world's models, in order
-        self.scope = _Scope("", "", None)
-        self.cache = {}
-        self.active = set()
-        self.override = {}
+        self.scope = Scope("", "", None)
+        self.frames = FrameGraph(self.warn)  # every frame's world pose
         self.poses = {}  # id(link or model) -> world pose a <state> set
 
     # -- messages
@@ -117,7 +75,7 @@ class _Reader:
 
     # -- world
     def read(self, path):
-        self.world = WorldDescription(name="", source=path)  # before load(): it may warn already
+        self.world = WorldDescription(name="", source=path, sdf=True)  # before load(): it may warn already
         root, src = self.files.load(path)
         worlds = root.findall("world")
         if not worlds:
@@ -196,13 +154,31 @@ class _Reader:
                         gravity_el = child
                 elif child.tag == "magnetic_field":
                     self.skip("magnetic_field")
-                elif len(child):  # an engine block (ode, bullet, ...): name what it sets
+                elif child.tag == "ode":
+                    self.ode_settings(child, src, f"{ppath}/ode")
+                elif len(child):  # another engine's block (bullet, simbody, dart): name what it sets
                     for grandchild in child:
                         self.skip(f"physics {child.tag}/{grandchild.tag}")
                 else:
                     self.skip(f"physics {child.tag}")
         if gravity_el is not None:
             self.world.gravity = self.values.floats(gravity_el.text, 3, src, f"{wpath}/gravity", "<gravity>")
+
+    def ode_settings(self, ode, src, path):
+        """``<physics><ode>``: its ``<solver><iters>`` sets Bullet's solver iterations (both solvers iterate over
+        the contacts and joints that many times per step); the rest is said in one line, with what Bullet does
+        instead."""
+        solver = ode.find("solver")
+        iters = solver.find("iters") if solver is not None else None
+        if iters is not None:
+            self.world.solver_iterations = int(self.values.number(solver, "iters", None, src, f"{path}/solver",
+                                                                  True))
+        rest = [f"{el.tag}/{item.tag} {(item.text or '').strip()}" for el in ode for item in el
+                if not (el.tag == "solver" and item.tag == "iters")]
+        rest += [f"{el.tag} {(el.text or '').strip()}" for el in ode if not len(el)]
+        if rest:
+            self.skip("physics ode " + ", ".join(rest) + " (Bullet's sequential-impulse solver with its own "
+                      "ERP 0.2, no SOR, no CFM, no contact correction cap; only <solver><iters> is taken)")
 
     def actor(self, el, src, path):
         """A Gazebo ``<actor>``: read as Gazebo 11 reads it (:mod:`diffbot_sim.world.actor_sdf`); its
@@ -271,7 +247,7 @@ class _Reader:
             raise ModelError("<model> has no name", src.path, path)
         name = name or own
         full = f"{parent.full}::{name}" if parent.full else name
-        model = _Model(name, full, parent, src, path)
+        model = SdfModel(name, full, parent, src, path)
         model.static = sdf_bool(text_of(el, "static", "false")) if static is None else static
         model.pose, model.relative_to = pose if pose is not None else self.values.child_pose(el, src, path)
         placement = text_of(el, "placement_frame")  # not in the spec, but cheap to honour if written
@@ -319,7 +295,7 @@ class _Reader:
         name = el.get("name")
         if not name:
             raise ModelError("<link> has no name", src.path, path)
-        link = _Link(name, model, src, path)
+        link = SdfLink(name, model, src, path)
         link.pose, link.relative_to = self.values.child_pose(el, src, path)
         inertial = el.find("inertial")
         if inertial is not None:
@@ -350,71 +326,6 @@ class _Reader:
             if shape is not None:
                 link.shapes.append(shape)
         return link
-
-    # -- poses
-    def world_pose(self, scope, name, src, path):
-        """World pose of the frame ``name`` as seen from ``scope`` ('' = the scope's own frame)."""
-        key = (id(scope), name)
-        if key in self.cache:
-            return self.cache[key]
-        if key in self.active:
-            raise ModelError(f"pose relative_to '{name}' is part of a cycle of frames", src.path, path)
-        self.active.add(key)
-        try:
-            pose = self.resolve(scope, name, src, path)
-        finally:
-            self.active.discard(key)
-        self.cache[key] = pose
-        return pose
-
-    def resolve(self, scope, name, src, path):
-        if name == "" or (scope.parent is not None and name == "__model__"):
-            return self.model_pose(scope) if scope.parent is not None else IDENTITY
-        if scope.parent is None and name == "world":
-            return IDENTITY
-        if "::" in name:
-            head, rest = name.split("::", 1)
-            if head in scope.models:
-                return self.world_pose(scope.models[head], rest, src, path)
-        if name in scope.links:
-            link = scope.links[name]
-            return compose(self.world_pose(scope, link.relative_to, link.src, f"{link.path}/pose"), link.pose)
-        if name in scope.models:
-            return self.model_pose(scope.models[name])
-        if name in scope.frames:
-            pose, rel, attached, fpath = scope.frames[name]
-            return compose(self.world_pose(scope, rel or attached, src, f"{fpath}/pose"), pose)
-        if name in scope.joints:
-            pose, rel, child = scope.joints[name]
-            return compose(self.world_pose(scope, rel or child, src, path), pose)
-        where = f"model {scope.full}" if scope.parent is not None else "the world"
-        self.warn(f"{src.path}: {path}: relative_to '{name}' names no frame of {where}; its own frame is used")
-        return self.world_pose(scope, "", src, path)
-
-    def model_pose(self, model):
-        if id(model) in self.override:
-            return self.override[id(model)]
-        key = (id(model), "__model__")
-        if key in self.cache:
-            return self.cache[key]
-        if key in self.active:
-            raise ModelError("model pose relative_to is part of a cycle of frames", model.src.path, model.path)
-        self.active.add(key)
-        try:
-            pose = compose(self.world_pose(model.parent, model.relative_to, model.src, f"{model.path}/pose"),
-                           model.pose)
-            if model.placement:
-                # The include pose places the placement frame, not the model frame: undo the frame's offset
-                # in the model, found by resolving it with the model frame at the origin.
-                sub = _Reader.__new__(_Reader)
-                sub.__dict__.update(self.__dict__)
-                sub.cache, sub.active, sub.override = {}, set(), {**self.override, id(model): IDENTITY}
-                offset = sub.world_pose(model, model.placement, model.src, f"{model.path}/placement_frame")
-                pose = compose(pose, inverse(offset))
-        finally:
-            self.active.discard(key)
-        self.cache[key] = pose
-        return pose
 
     # -- state
     def state(self, el, src, path):
@@ -469,10 +380,9 @@ class _Reader:
     def current(self, node):
         if id(node) in self.poses:
             return self.poses[id(node)]
-        if isinstance(node, _Link):
-            return compose(self.world_pose(node.model, node.relative_to, node.src, f"{node.path}/pose"),
-                           node.pose)
-        return self.model_pose(node)
+        if isinstance(node, SdfLink):
+            return self.frames.link_pose(node)
+        return self.frames.model_pose(node)
 
     def move(self, model, delta):
         self.poses[id(model)] = compose(delta, self.current(model))
@@ -488,10 +398,10 @@ class _Reader:
         def walk(model, static, top):
             static = static or model.static
             for link in model.links.values():
-                placed = compose(self.world_pose(model, link.relative_to, link.src, f"{link.path}/pose"), link.pose)
+                placed = self.frames.link_pose(link)
                 pose = poses.get(id(link)) or placed
                 # The top-level model's frame, moved with the link by a <state> (the model moves rigidly).
-                in_model = compose(inverse(self.model_pose(top)), placed)
+                in_model = compose(inverse(self.frames.model_pose(top)), placed)
                 if not static and any(s.kind == "plane" for s in link.shapes):
                     self.warn(f"{link.src.path}: {link.path}: a plane in a non-static model is not simulated")
                 mass = link.mass

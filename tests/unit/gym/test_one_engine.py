@@ -116,7 +116,8 @@ def through_bullet_sim(endpoints, timeout):
     """The trajectory (one sample per command) of the model in bullet_sim: its world, robot and plugins."""
     cfg = cfgmod.SimConfig(model=MODEL, world=WORLD, real_time=False, cmd_vel_timeout=timeout)
     description = load_world(cfg.world, cfg.map_wall_height)
-    sim_robots.apply_world_physics(cfg, description, {})
+    # the step given, as sim.launch gives bullet_sim its ~time_step (unset, a Gazebo world's own step rules)
+    sim_robots.apply_world_physics(cfg, description, {"time_step": cfg.time_step})
     world = World(cfg.time_step, cfg.gravity)
     try:
         world.load_world(description, meshes.default_cache_dir())

@@ -190,3 +190,66 @@ def test_every_plugin_is_called_in_order_and_close_goes_to_the_context():
     runtime.close()
     assert calls[-2:] == [("a", "close", None), ("b", "close", None)] and ctx.closed
 
+
+
+# -- how many physics steps run with no Python between them, and real-time pacing after a stall ---------------
+
+class Due:
+    """A plugin as the loop asks it: when its control and its next publication are due."""
+
+    def __init__(self, control=math.inf, publish=math.inf):
+        self.control, self.publish = control, publish
+
+    def next_control(self):
+        return self.control
+
+    def next_publish(self):
+        return self.publish
+
+
+def bare_loop(time_step=0.001, plugins=(), next_publish=math.inf, landing=(), actors=None, api=None):
+    """A Simulator with only what _batch and _real_time_room read (no master, no physics)."""
+    from types import SimpleNamespace
+
+    from diffbot_sim.simulator.loop import Simulator
+    sim = Simulator.__new__(Simulator)
+    sim.cfg = SimpleNamespace(time_step=time_step, real_time_factor=1.0)
+    sim.steps, sim._time_base, sim._steps_base = 0, 0.0, 0
+    sim.world = SimpleNamespace(landing=list(landing))
+    sim.actors, sim.api = actors, api
+    sim.robots = [RobotRuntime("r", None, list(plugins))]
+    sim._next_publish = next_publish
+    sim.wall0, sim.sim0 = 0.0, 0.0
+    return sim
+
+
+def test_steps_run_in_one_go_up_to_the_first_work_due():
+    """1 ms steps, odometry due at 10 ms and nothing else: ten steps with no Python between them; a plugin with
+    work every step (a torque, a wrench) or a robot being set down: one."""
+    sim = bare_loop(next_publish=0.010)
+    assert sim._batch(100) == 10
+    assert sim._batch(4) == 4  # real-time pacing allows only 4 now
+    sim.steps = 3
+    assert sim._batch(100) == 7
+    assert bare_loop(plugins=[Due(control=0.004)], next_publish=0.010)._batch(100) == 4
+    assert bare_loop(plugins=[Due(control=0.0)], next_publish=0.010)._batch(100) == 1
+    assert bare_loop(next_publish=0.010, landing=["robot"])._batch(100) == 1
+    assert bare_loop(next_publish=0.010, actors=object())._batch(100) == 1
+    busy = type("Api", (), {"busy": lambda self: True})()
+    assert bare_loop(next_publish=0.010, api=busy)._batch(100) == 1
+    assert bare_loop(next_publish=math.inf)._batch(100) == 100
+
+
+def test_real_time_pacing_does_not_race_to_make_up_a_stall():
+    """Paced at RTF 1 with 1 ms steps: 3 ms of wall time due is 3 steps; after a 0.6 s stall (a spawn) the
+    simulation does not run 600 steps to catch up (Gazebo paces each step from the last): one step is due and
+    pacing goes on from there. A lag under MAX_CATCH_UP (a late wake-up) is made up."""
+    from diffbot_sim.simulator.loop import MAX_CATCH_UP
+    sim = bare_loop()
+    assert sim._real_time_room(0.0035)[0] == 3
+    sim.steps = 3
+    assert sim._real_time_room(0.6035)[0] == 1
+    sim.steps = 4
+    assert sim._real_time_room(0.6045)[0] == 1  # and on at the wall clock's pace, from the stall's end
+    assert sim._real_time_room(0.6045 + MAX_CATCH_UP / 2)[0] == 1 + round(MAX_CATCH_UP / 2 / 0.001)
+    assert bare_loop()._real_time_room(0.0005)[0] == 0  # not yet: wait

@@ -204,9 +204,12 @@ def test_turtlebot3_style_world(tmp_path):
     assert world.gravity == (0, 0, -9.81)  # 1.4: gravity lives in <physics>
     assert world.has_ground and world.max_step_size == 0.001 and world.real_time_factor == 1.0
     assert world.real_time_update_rate == 1000.0
-    for item in ("light sun (directional)", "plugin libobstacle_2.so in model obstacle_2", "scene", "gui",
-                 "physics ode/solver", "physics ode/constraints"):
+    assert world.sdf and world.solver_iterations == 150  # <ode><solver><iters>: Bullet's solver iterations
+    for item in ("light sun (directional)", "plugin libobstacle_2.so in model obstacle_2", "scene", "gui"):
         assert item in world.not_simulated
+    ode = [item for item in world.not_simulated if item.startswith("physics ode ")]
+    assert len(ode) == 1 and "solver/type quick" in ode[0] and "constraints/cfm 0.00001" in ode[0]
+    assert "only <solver><iters> is taken" in ode[0]
     assert len(world.not_simulated) == len(set(world.not_simulated))
     assert world.warnings == []
     # the tiny .dae is a real COLLADA file our mesh reader takes (inch units honoured)

@@ -50,7 +50,9 @@ class RosControl(Plugin):
         return self.manager.publishers()
 
     def next_control(self):
-        return self.ctx.sim.sim_time if self.hw.joints else math.inf
+        """Every step while the hardware has work (torques, a limit still clipping, a new command); a robot whose
+        joints are all PyBullet motors holding their targets has none until a controller's next update."""
+        return self.ctx.sim.sim_time if self.hw.busy or self._estop is not None else math.inf
 
     def next_publish(self):
         return self.ctx.sim.sim_time if self.manager.step_due() else self.manager.next_update

@@ -102,6 +102,9 @@ class RobotHWSim:
         robot.free_joints([j.index for j in self.joints.values() if j.torque_driven])
         self._order = list(self.joints.values())
         self._indices = [j.index for j in self._order]
+        #: False once a write changed nothing the physics holds (every joint a PyBullet motor whose target is
+        #: the controller's command, unclipped by its limits): until a command changes, the steps need no write
+        self.busy = True
 
     def _make_joint(self, trans, ns, warnings):
         urdf_joint = self.ctx.model.joints.get(trans.joint)
@@ -152,7 +155,10 @@ class RobotHWSim:
 
     def set_command(self, joint, value):
         """A controller's command (rad, m, rad/s, m/s, N·m or N, per the joint's interface)."""
-        self.joints[joint].command = value
+        sim_joint = self.joints[joint]
+        if value != sim_joint.command:
+            sim_joint.command = value
+            self.busy = True
 
     def explicit_margin(self, joint, gains, loop):
         """How much of its stability bound a controller's PID (``gains``, on ``loop`` "position" or
@@ -166,9 +172,11 @@ class RobotHWSim:
         cannot run explicitly at our step."""
         sim_joint = self.joints[joint]
         sim_joint.target_mode, sim_joint.target_force, sim_joint.pushed = mode, force, None
+        self.busy = True
 
     def set_target_force(self, joint, force):
         self.joints[joint].target_force = force
+        self.busy = True
 
     def positions(self, names):
         return [self.joints[n].position for n in names]
@@ -178,6 +186,7 @@ class RobotHWSim:
 
     def set_estop(self, active):
         """eStopTopic: on the first active update, position commands freeze at the measured positions."""
+        self.busy = True
         if active and not self.estop:
             for joint in self._order:
                 joint.frozen = joint.position
@@ -203,6 +212,7 @@ class RobotHWSim:
     def start(self):
         """Buffers as initSim leaves them: every command 0, PIDs reset; limit handles re-read positions."""
         self.read()
+        self.busy = True
         for joint in self._order:
             joint.command, joint.frozen, joint.pushed = 0.0, None, None
             if joint.pid is not None:
@@ -211,12 +221,16 @@ class RobotHWSim:
                 joint.limit_handle.reset(None)
 
     def write(self, dt):
-        """writeSim, every physics step: each joint's command, limited, to the physics."""
+        """writeSim, every physics step: each joint's command, limited, to the physics. Sets ``busy``: whether
+        the next step needs a write too (a torque lasts one step; a limit still clipping a command moves its
+        bound every step); a motor holding an unclipped command needs none until the command changes."""
         if not self._order:
+            self.busy = False
             return
         robot = self.ctx.robot
         positions, velocities, _ = robot.joint_states(self._indices)
         torques, torque_idx = [], []
+        busy = False
         for joint, raw, velocity in zip(self._order, positions, velocities):
             position = raw if joint.position is None or joint.joint_type == "prismatic" else \
                 joint.position + shortest_angular_distance(joint.position, raw)
@@ -231,8 +245,11 @@ class RobotHWSim:
                                lambda: robot.set_velocities([joint.index], [command], [force]))
                 continue
             if joint.limit_handle is not None:
+                wanted = command
                 command = joint.limit_handle.enforce(command, position, velocity, dt)
+                busy = busy or command != wanted
             if joint.torque_driven:
+                busy = True
                 effort = command if joint.method == EFFORT else self._pid_effort(joint, command, position, velocity, dt)
                 effort = _truncate(effort, velocity, joint)
                 joint.effort = effort
@@ -247,6 +264,7 @@ class RobotHWSim:
                     [joint.index], [command], [joint.motor_force]))
         if torque_idx:
             robot.set_efforts(torque_idx, torques)
+        self.busy = busy
 
     def _command(self, joint):
         if not self.estop:
