@@ -41,7 +41,7 @@ from gazebo_msgs.msg import ModelStates
 from gazebo_msgs.srv import GetModelState
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from nav_msgs.msg import OccupancyGrid
-from simtest import Latest, TfEdges, action_done, figure, wait_for, yaw_of
+from simtest import Latest, TfEdges, action_done, figure, sim_now, wait_for, yaw_of
 
 from diffbot_sim.check import map_check
 from diffbot_sim.world.loading import load_world
@@ -181,8 +181,11 @@ class MultiSlamTest(MultiNavTest):
         world = load_world(rospy.get_param("~world"), 1.0)
         sections = map_check.world_section(world, float(rospy.get_param("~laser_height")))
         failures = []
+        # maps stamped after the simulator's time now, when every tour is known to be over (this node's clock can
+        # lag it: a map stamped after that could still miss a tour's last part)
+        ended = sim_now()
         for name in self.names:
-            msg = wait_for(lambda: (m := self.maps[name].get()) is not None and m.header.stamp.to_sec() > done_at
+            msg = wait_for(lambda: (m := self.maps[name].get()) is not None and m.header.stamp.to_sec() > ended
                            and m, 120.0, f"a /{name}/map published after the tours")
             # gmapping stamps its /map with tf_.resolve(map_frame): the tf_prefix it finds from its namespace is
             # put before the already prefixed frame once more (its TF is tb3_N/map -> tb3_N/odom all the same).

@@ -21,7 +21,7 @@ import unittest
 import rospy
 import rostest
 from nav_msgs.msg import OccupancyGrid
-from simtest import figure, wait_for
+from simtest import figure, sim_now, wait_for
 
 from diffbot_sim.check import map_check
 from diffbot_sim.world.loading import load_world
@@ -54,7 +54,10 @@ class SlamTest(unittest.TestCase):
         wall = time.monotonic() - wall0
         figure(f"tour: {done_at - sim0:.1f} s of sim time in {wall:.1f} s of wall time: "
                f"RTF {(done_at - sim0) / wall:.2f}")
-        msg = wait_for(lambda: (m := self.latest_map()) is not None and m.header.stamp.to_sec() > done_at and m,
+        # a map stamped after the simulator's time now, when the tour is known to be over (this node's clock can
+        # lag it: a map stamped after that could still miss the tour's last part)
+        ended = sim_now()
+        msg = wait_for(lambda: (m := self.latest_map()) is not None and m.header.stamp.to_sec() > ended and m,
                        120.0, "a map published after the tour")
         grid = map_check.Grid.from_message(msg)
         world = load_world(rospy.get_param("~world"), 1.0)
