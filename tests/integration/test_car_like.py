@@ -5,7 +5,8 @@ started by its spawner, ``/clock`` global; straight ahead without turning; at st
 middle runs on the circle the steering geometry gives (radius L / tan δ) without sliding sideways.
 
 Parameters: ~gazebo (the world API's namespace), ~model, ~ns (the controller manager's namespace), ~wheelbase
-(m), ~rear_axle ([x, y] of the rear axle's middle in the body frame), ~rest_height (m, base_link above ground).
+(m), ~rear_axle ([x, y] of the rear axle's middle in the body frame), ~rest_height (m, base_link above ground),
+~track (m, a SteerBotHardwareGazebo base's steering axes apart), ~arc_speed (m/s) and ~arc_seconds (s).
 """
 import math
 import sys
@@ -40,6 +41,10 @@ class CarLikeTest(unittest.TestCase):
         # a SteerBotHardwareGazebo base: its YAML, whose linkage sets the real front wheels' angles
         cls.steer_bot = rospy.get_param(cls.ns + "/steer_bot_hardware_gazebo", None)
         cls.track = rospy.get_param("~track", 0.0)
+        # m/s, s: "no lateral slip at low speed": a car whose wheels all turn at one speed (SteerBotHardwareGazebo)
+        # scrubs in a turn with a force that grows with speed (Gazebo's SetVelocity couples each wheel by its inertia)
+        cls.arc_speed = rospy.get_param("~arc_speed", arc_check.ARC_SPEED)
+        cls.arc_seconds = rospy.get_param("~arc_seconds", arc_check.ARC_SECONDS)
         rospy.wait_for_service(cls.gazebo + "/get_model_state", 60.0)
         cls.state = rospy.ServiceProxy(cls.gazebo + "/get_model_state", GetModelState)
         cls.cmd = rospy.Publisher(cls.ns + "/ackermann_steering_controller/cmd_vel", Twist, queue_size=1)
@@ -109,7 +114,7 @@ class CarLikeTest(unittest.TestCase):
 
     def test_3_arc_at_the_geometry_radius_without_slip(self):
         for steer in (arc_check.ARC_STEER, -arc_check.ARC_STEER):
-            samples = self.drive(arc_check.ARC_SPEED, steer, arc_check.ARC_SECONDS)
+            samples = self.drive(self.arc_speed, steer, self.arc_seconds)
             steady = [s for t, s, _ in samples if t >= samples[0][0] + 1.0]  # past the steering's travel
             radius_range = None
             if self.steer_bot is not None:  # the body turns between the radii its two front wheels imply
@@ -125,7 +130,8 @@ class CarLikeTest(unittest.TestCase):
             figure(f"{self.model} arc at steer {steer:+.2f} rad: radius {result.radius:.3f} m (geometry "
                    f"{result.expected:.3f} m, error {100 * (result.radius / result.expected - 1):+.2f} %), slip up to "
                    f"{result.max_slip:.4f} rad, turned {result.turned:.2f} rad; odometry's yaw rate "
-                   f"{odom.twist.twist.angular.z:+.3f} rad/s (geometry {arc_check.ARC_SPEED / result.expected:.3f})")
+                   f"{odom.twist.twist.angular.z:+.3f} rad/s (geometry {self.arc_speed / result.expected:.3f}), at "
+                   f"{self.arc_speed:g} m/s")
             self.assertTrue(result.passed, "; ".join(result.failures))
             self.assertGreater(result.turned * steer, 0, "turned toward the steered side (REP 103: + is left)")
             self.assertLess(max(abs(z - self.rest_height) for *_, z in samples), 0.02)
