@@ -1,13 +1,14 @@
 """The vendor message packages of the overlay are their upstreams', md5 sum for md5 sum.
 
 ROS 1 peers refuse a connection whose md5 sum differs, so a client of four_wheel_steering_controller,
-a Kobuki's event listeners or a link-attacher caller connects here only with upstream's definitions.
+a Kobuki's event listeners, a link-attacher caller or a franka_gazebo user (FrankaState, the gripper's actions)
+connects here only with upstream's definitions.
 
 UPSTREAM_MD5 was computed with ``genmsg.compute_md5`` from the files of each pinned upstream commit (named in
 each package's README.md), exported to a temporary directory, with Debian's /usr/share/<pkg>/msg for the
 standard dependencies; FourWheelSteeringStamped's value also appears in code others generated from the real
-package (rosserial, genlisp, gennodejs), and so do BumperEvent's and Attach's. An .action is first expanded by Debian's
-actionlib_msgs genaction.py (what catkin's add_action_files runs) into its seven messages.
+package (rosserial, genlisp, gennodejs), and so do BumperEvent's, Attach's and FrankaState's. An .action is first
+expanded by Debian's actionlib_msgs genaction.py (what catkin's add_action_files runs) into its seven messages.
 """
 import glob
 import importlib
@@ -47,6 +48,51 @@ UPSTREAM_MD5 = {
     "kobuki_msgs/VersionInfo": "3dc0ce6edd49be1fc86730f4a4a21861",
     "kobuki_msgs/WheelDropEvent": "e102837d89384d67669a0df86b63f33b",
     "gazebo_ros_link_attacher/Attach": "c91fb3be70ce66d19130d40294cf4bd5",
+    "franka_gripper/GraspAction": "6f89449359949eaf1f0fef57b7e0db2a",
+    "franka_gripper/GraspActionFeedback": "aae20e09065c3809e8a8e87c4c8953fd",
+    "franka_gripper/GraspActionGoal": "7bd1a6e7f94ef15bb6dd05cb170e7909",
+    "franka_gripper/GraspActionResult": "89dbc4e75593b525bbbea3a150532ed6",
+    "franka_gripper/GraspEpsilon": "95b2c5464a6f679bd1dacaf86414f095",
+    "franka_gripper/GraspFeedback": "d41d8cd98f00b204e9800998ecf8427e",
+    "franka_gripper/GraspGoal": "627a0f0b10ad0c919fbd62b0b3427e63",
+    "franka_gripper/GraspResult": "45872d25d65c97743cc71afc6d4e884d",
+    "franka_gripper/HomingAction": "f37964fcdec026d9507d088d32b65b38",
+    "franka_gripper/HomingActionFeedback": "aae20e09065c3809e8a8e87c4c8953fd",
+    "franka_gripper/HomingActionGoal": "4b30be6cd12b9e72826df56b481f40e0",
+    "franka_gripper/HomingActionResult": "89dbc4e75593b525bbbea3a150532ed6",
+    "franka_gripper/HomingFeedback": "d41d8cd98f00b204e9800998ecf8427e",
+    "franka_gripper/HomingGoal": "d41d8cd98f00b204e9800998ecf8427e",
+    "franka_gripper/HomingResult": "45872d25d65c97743cc71afc6d4e884d",
+    "franka_gripper/MoveAction": "85e8e11f508e446b706022926779afee",
+    "franka_gripper/MoveActionFeedback": "aae20e09065c3809e8a8e87c4c8953fd",
+    "franka_gripper/MoveActionGoal": "f8907a1e7bb902f2e4c7db8e1cf3d24f",
+    "franka_gripper/MoveActionResult": "89dbc4e75593b525bbbea3a150532ed6",
+    "franka_gripper/MoveFeedback": "d41d8cd98f00b204e9800998ecf8427e",
+    "franka_gripper/MoveGoal": "d16050a0fe85f1c2cb8347c99678362e",
+    "franka_gripper/MoveResult": "45872d25d65c97743cc71afc6d4e884d",
+    "franka_gripper/StopAction": "f37964fcdec026d9507d088d32b65b38",
+    "franka_gripper/StopActionFeedback": "aae20e09065c3809e8a8e87c4c8953fd",
+    "franka_gripper/StopActionGoal": "4b30be6cd12b9e72826df56b481f40e0",
+    "franka_gripper/StopActionResult": "89dbc4e75593b525bbbea3a150532ed6",
+    "franka_gripper/StopFeedback": "d41d8cd98f00b204e9800998ecf8427e",
+    "franka_gripper/StopGoal": "d41d8cd98f00b204e9800998ecf8427e",
+    "franka_gripper/StopResult": "45872d25d65c97743cc71afc6d4e884d",
+    "franka_msgs/ErrorRecoveryAction": "d5a016b49f278075666fbc901debbd08",
+    "franka_msgs/ErrorRecoveryActionFeedback": "aae20e09065c3809e8a8e87c4c8953fd",
+    "franka_msgs/ErrorRecoveryActionGoal": "4b30be6cd12b9e72826df56b481f40e0",
+    "franka_msgs/ErrorRecoveryActionResult": "1eb06eeff08fa7ea874431638cb52332",
+    "franka_msgs/ErrorRecoveryFeedback": "d41d8cd98f00b204e9800998ecf8427e",
+    "franka_msgs/ErrorRecoveryGoal": "d41d8cd98f00b204e9800998ecf8427e",
+    "franka_msgs/ErrorRecoveryResult": "d41d8cd98f00b204e9800998ecf8427e",
+    "franka_msgs/Errors": "082e9a670c96d8bc64b53e32777458e7",
+    "franka_msgs/FrankaState": "431567d5df6caf4e4dd7385f25cb71ee",
+    "franka_msgs/SetCartesianImpedance": "c648a0b1340a53eac0c535568e9b5c60",
+    "franka_msgs/SetEEFrame": "459aea8fa6dbdd34ba4bc52d3eddbacf",
+    "franka_msgs/SetForceTorqueCollisionBehavior": "b1e592d1b6960bc05e6e3cba1eb02349",
+    "franka_msgs/SetFullCollisionBehavior": "c6fef9a8ad446db9a39cca3b7bc200d8",
+    "franka_msgs/SetJointImpedance": "f11c4defa2a13040512214f9d77dc982",
+    "franka_msgs/SetKFrame": "11b22d30e6a11a7b51828be575a77359",
+    "franka_msgs/SetLoad": "c9a8ec436164dd9cbc1e5e137d358e0b",
 }
 PACKAGES = sorted({name.split("/")[0] for name in UPSTREAM_MD5})
 GENACTION = "/usr/lib/actionlib_msgs/genaction.py"
