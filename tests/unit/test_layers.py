@@ -154,6 +154,22 @@ def test_the_package_keeps_its_layers():
     assert problems(graph) == []
 
 
+#: The most lines a module may have: past this it has more than one job (docs/architecture.md, "Module size").
+MAX_MODULE_LINES = 500
+
+
+def test_no_module_is_over_500_lines():
+    sizes = {}
+    for dirpath, _, files in os.walk(PACKAGE):
+        for name in files:
+            if name.endswith(".py"):
+                path = os.path.join(dirpath, name)
+                with open(path) as module:
+                    sizes[os.path.relpath(path, PACKAGE)] = sum(1 for _ in module)
+    assert len(sizes) > 50  # the walk found the package
+    assert {path: lines for path, lines in sizes.items() if lines > MAX_MODULE_LINES} == {}
+
+
 def test_every_subpackage_has_a_layer():
     units = {name for name in os.listdir(PACKAGE) if not name.startswith("__")}
     units = {u[:-3] if u.endswith(".py") else u for u in units}

@@ -31,7 +31,7 @@ import threading
 import time
 
 from diffbot_sim import streams
-from diffbot_sim.check import arc_check, drive_check, robot_report
+from diffbot_sim.check import arc_check, drive_check, report_text, robot_report
 from diffbot_sim.check.session import SIM, Session, SessionError
 from diffbot_sim.description.model_files import package_path
 from diffbot_sim.errors import DiffbotSimError, ModelError
@@ -105,7 +105,7 @@ def main(argv=None):
     except DiffbotSimError as err:
         streams.write(sys.stderr, f"robot_check: {err}\n")
         return 1
-    for line in robot_report.format_report(report):
+    for line in report_text.format_report(report):
         _say(line)
     if report.drive is None and not report.arm_joints:
         _say("result: FAIL: no drive was found, so there is nothing to drive")
@@ -257,7 +257,7 @@ def _drive(session, report):
     _say(f"drive test (bullet_sim headless, 3x real time): {cmd_topic} -> {odom_topic}, {SIM}/ground_truth")
     logged = session.sim_warnings()
     extra = [w for w in logged if w not in report.warnings]
-    for text in extra[:robot_report.MAX_WARNINGS]:
+    for text in extra[:report_text.MAX_WARNINGS]:
         _say(f"  bullet_sim also warned: {text}")
     if not cmd_topic or not odom_topic:
         raise SessionError("bullet_sim reports no command or odometry topic for the drive "
@@ -334,14 +334,14 @@ def _verdict(session, report, logged, rest, straight, straight_body, turned=(Non
              arc=None):
     """Print the drive's judgements and return (passed, verdict)."""
     (turn, turn_body), (strafe, strafe_body) = turned, strafed
-    for line in robot_report.format_rest(rest):
+    for line in report_text.format_rest(rest):
         _say(line)
     if arc is None:
-        for line in robot_report.format_motions(straight, turn, straight_body, turn_body, strafe, strafe_body):
+        for line in report_text.format_motions(straight, turn, straight_body, turn_body, strafe, strafe_body):
             _say(line)
     else:
         result, body = arc
-        for line in robot_report.format_motions(straight, None, straight_body):
+        for line in report_text.format_motions(straight, None, straight_body):
             _say(line)
         gives = (f"{result.expected:.3f} m (L / tan {arc_check.ARC_STEER:g})" if report.drive.radius_range is None
                  else "{:.3f}..{:.3f} m (its front wheels' angles)".format(*sorted(map(abs,

@@ -1,11 +1,11 @@
-"""robot_report.py and drive_check.py: what robot_check says about the fixture robots, and how it judges a
+"""robot_report, report_text and drive_check: what robot_check says about the fixture robots, and how it judges a
 drive. No master: the report is built in-process (PyBullet DIRECT for the loaded mass)."""
 import os
 
 import pytest
 import yaml
 
-from diffbot_sim.check import drive_check, robot_report
+from diffbot_sim.check import drive_check, report_text, robot_report
 from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.plugins.registry import KNOWN, KNOWN_SENSORS
 
@@ -125,7 +125,7 @@ def test_geometry_measured_when_the_plugin_gives_none(report, make_urdf):
 def test_no_drive_fixture(report):
     r = report("no_drive.urdf")
     assert r.drive is None and r.urdf_mass == pytest.approx(1.4)
-    lines = robot_report.format_report(r)
+    lines = report_text.format_report(r)
     assert any(line.startswith("drive: none found") for line in lines)
     # its camera has a plugin bullet_sim simulates (libgazebo_ros_camera.so); the fixed caster's bare IMU has none
     assert [(i.kind, i.name, i.simulated) for i in r.items] == [("sensor", "front_camera", True)]
@@ -155,21 +155,21 @@ def test_a_bad_controller_parameter_is_named(report, tmp_path):
                                           ("pid_robot.urdf", ("pid_robot.yaml",)), ("skid_steer.urdf", ()),
                                           ("no_drive.urdf", ())])
 def test_the_report_fits_one_screen(report, model, yamls):
-    lines = robot_report.format_report(report(model, *yamls))
+    lines = report_text.format_report(report(model, *yamls))
     assert len(lines) + 6 <= 40  # the drive test adds at most six lines
     assert lines[0].startswith("model: ") and lines[1].startswith("mass: URDF ")
 
 
 def test_mass_difference_is_shown():
     r = robot_report.Report("/m.urdf", "m", 1.0, 2.0)
-    assert "differs by +1.0000 kg" in robot_report.format_report(r)[1]
+    assert "differs by +1.0000 kg" in report_text.format_report(r)[1]
     r.loaded_mass = 1.0000001
-    assert "differs" not in robot_report.format_report(r)[1]
+    assert "differs" not in report_text.format_report(r)[1]
 
 
 def test_warnings_are_capped():
     r = robot_report.Report("/m.urdf", "m", 1.0, 1.0, warnings=[f"w{i}" for i in range(25)])
-    lines = robot_report.format_report(r)
+    lines = report_text.format_report(r)
     assert "  ... and 15 more" in lines and "warnings bullet_sim logs at start: 25" in lines
 
 

@@ -7,7 +7,7 @@ import subprocess
 import pytest
 import yaml
 
-from diffbot_sim.check import arc_check, robot_report
+from diffbot_sim.check import arc_check, report_text, robot_report
 from diffbot_sim.plugins.registry import KNOWN, KNOWN_SENSORS
 
 DATA = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "data")
@@ -41,7 +41,7 @@ def test_bicycle_is_a_car_with_its_wheelbase(tmp_path):
     assert report.car and report.drive.wheelbase == pytest.approx(0.4)
     assert report.drive.rear_axle == pytest.approx((-0.2, 0.0)) and report.drive.radius_range is None
     assert not report.arm_joints  # the steering joint is the car's, not an arm's
-    assert any("car-like" in line for line in robot_report.format_report(report))
+    assert any("car-like" in line for line in report_text.format_report(report))
 
 
 def test_steer_bot_base_gives_its_front_wheels_radii(tmp_path):
@@ -62,4 +62,4 @@ def test_contact_sensors_are_listed(tmp_path):
     assert len(report.contacts) == 3
     assert "base_footprint_fixed_joint_lump__base_link_collision" in report.contacts[0]
     assert "/bumper_states" in report.contacts[0] and "events/bumper" in report.contacts[0]
-    assert "contact sensors:" in robot_report.format_report(report)
+    assert "contact sensors:" in report_text.format_report(report)
