@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """A known load on a force-torque joint (tests/data/robots/ft_load.urdf): libgazebo_ros_ft_sensor.so reports the
 force and torque the joint applies on the 2 kg load, in the load's frame, the torque about the joint: m g up and
--m g * 0.1 about y (the centre of mass 0.1 m beside it; g the world's, /gazebo/get_physics_properties); its gaussianNoise has the stddev asked; the
+-m g * 0.1 about y (the centre of mass 0.1 m beside it; g the world's, /gazebo/get_physics_properties); its
+gaussianNoise has the stddev asked; the
 <sensor type="force_torque"> measuring parent_to_child reads the negation."""
 import statistics
 import sys

@@ -9,10 +9,10 @@ import unittest
 import rospy
 import rostest
 from gazebo_msgs.srv import ApplyBodyWrench, GetModelState
-from std_srvs.srv import Empty
 from gazebo_ros_link_attacher.srv import Attach
 from geometry_msgs.msg import Wrench
 from simtest import figure, wait_for
+from std_srvs.srv import Empty
 
 
 class LinkAttacherTest(unittest.TestCase):

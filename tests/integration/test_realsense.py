@@ -20,7 +20,7 @@ class RealSenseTest(unittest.TestCase):
         cls.infos = {s: Latest(f"/camera/{s}/camera_info", CameraInfo) for s in ("color", "depth")}
 
     def test_streams_and_depth(self):
-        msgs = {s: wait_for(l.get, 30.0, f"/camera/{s}/image_raw") for s, l in self.images.items()}
+        msgs = {s: wait_for(latest.get, 30.0, f"/camera/{s}/image_raw") for s, latest in self.images.items()}
         self.assertEqual([msgs[s].encoding for s in ("color", "infra1", "infra2", "depth")],
                          ["rgb8", "8UC1", "8UC1", "16UC1"])
         self.assertEqual(msgs["depth"].header.frame_id, "d435_depth_optical_frame")
