@@ -31,13 +31,13 @@ import os
 import sys
 import time
 
-from bench_items import arm, batch, drive, fleet, learning, sensors, startup, world_api
+from bench_items import arm, batch, drive, fixed_arm, fleet, learning, sensors, startup, world_api
 from benchkit import probes
 from benchkit.common import RESULTS, STEP
 from benchkit.report import table, write_results
 
 #: the item modules, in the order their items run and their rows are printed
-THEMES = [drive, startup, sensors, world_api, batch, arm, learning, fleet]
+THEMES = [drive, startup, sensors, world_api, batch, arm, fixed_arm, learning, fleet]
 ITEMS = [item for theme in THEMES for item in theme.ITEMS]
 PROBES = dict(probes.PROBES, **{kind: probe for theme in THEMES for kind, probe in theme.PROBES.items()})
 

@@ -11,12 +11,13 @@ from benchkit.stats import percentile
 from diffbot_sim.waiting import wait_for
 
 
-def sim_pid():
-    """The pid of the simulator node (``/bullet_sim``), asked through its XML-RPC API."""
+def sim_pid(node="/bullet_sim"):
+    """The pid of the simulator node (``/bullet_sim``; ``/gazebo`` when empty_world.launch started it), asked
+    through its XML-RPC API."""
     import xmlrpc.client
 
     import rosnode
-    uri = rosnode.get_api_uri(rosnode.rosgraph.Master("/bench"), "/bullet_sim", skip_cache=True)
+    uri = rosnode.get_api_uri(rosnode.rosgraph.Master("/bench"), node, skip_cache=True)
     return xmlrpc.client.ServerProxy(uri).getPid("/bench")[2]
 
 
@@ -77,7 +78,7 @@ def probe_rtf(options):
         for pub in pubs:
             pub.unregister()
         time.sleep(1.0)
-    pid = sim_pid()
+    pid = sim_pid(options.get("sim_node", "/bullet_sim"))
     cpu0, n0 = cpu_seconds(pid), len(clock)
     time.sleep(options["seconds"])
     cpu1, n1 = cpu_seconds(pid), len(clock)
