@@ -3,7 +3,7 @@ SHELL := /bin/bash
 ROOT := $(abspath $(dir $(lastword $(MAKEFILE_LIST))))
 ENV := $(ROOT)/tools/rosenv.sh
 
-.PHONY: setup run test test-slow test-nav unit bench pictures clean nav install
+.PHONY: setup run test test-slow test-nav unit bench pictures clean nav install moveit test-moveit
 
 setup:
 	@bash $(ROOT)/tools/setup.sh
@@ -36,6 +36,17 @@ nav: setup
 # judged by ground truth), at real time and in fast mode; after `make nav`. About 15 minutes.
 test-nav: setup
 	@bash $(ENV) python3 $(ROOT)/tools/run_tests.py --nav
+
+# MoveIt 1 (noetic-devel 1.1.14) and the packages Debian 12 lacks, built into moveit_ws/ (about an hour on 2 cores
+# the first time, seconds after; docs/moveit.md). MOVEIT_SOURCES=DIR[:DIR...] takes the pinned tarballs instead of
+# cloning; MOVEIT_RVIZ=0 leaves out rviz's MotionPlanning plugin.
+moveit: setup
+	@MOVEIT_SOURCES="$(MOVEIT_SOURCES)" MOVEIT_RVIZ="$(MOVEIT_RVIZ)" bash $(ROOT)/tools/moveit.sh
+
+# The MoveIt suites (tests/integration/moveit_*.test: plans executed in the simulator, judged by ground truth),
+# at real time and in fast mode; after `make moveit`.
+test-moveit: setup
+	@bash $(ENV) python3 $(ROOT)/tools/run_tests.py --moveit
 
 # An install space for users and images: DIR/setup.bash is all it needs, with this checkout gone (docs/install.md).
 PREFIX = $(ROOT)/install

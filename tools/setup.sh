@@ -106,6 +106,12 @@ for entry in package.xml CMakeLists.txt setup.py cmake src scripts launch urdf c
   fi
 done
 
+# moveit_config/ is a second package of this repository, diffbot_arm_moveit_config (MoveIt's files for
+# diffbot_arm; it needs MoveIt only when launched): linked as catkin_ws/src/diffbot_arm_moveit_config.
+if [ "$(readlink "$WS/src/diffbot_arm_moveit_config" 2>/dev/null)" != "../../moveit_config" ]; then
+  ln -sfn "../../moveit_config" "$WS/src/diffbot_arm_moveit_config"
+fi
+
 # overlay/ holds drop-in catkin packages for ROS 1 packages Debian does not ship (gazebo_msgs,
 # controller_manager_msgs, ...). Each directory with a package.xml is linked as catkin_ws/src/<name> ->
 # ../../overlay/<name>. DIFFBOT_SIM_OVERLAY=0 leaves them all out (for a machine with the real packages,
@@ -155,13 +161,17 @@ overlay_sig() {
 }
 want_overlay="${overlay_pkgs[*]}
 $(overlay_sig)"
-# The navigation workspace `make nav` builds (nav_ws/) is this workspace's underlay when it exists: catkin then
-# chains it, and `source catkin_ws/devel/setup.bash` alone finds amcl, move_base and gmapping too. A change of
-# underlay needs a fresh configure (catkin caches the chain), so it is stamped like the overlay packages.
-NAV_SETUP="$ROOT/nav_ws/devel/setup.sh"
+# The workspaces `make nav` and `make moveit` build (nav_ws/, moveit_ws/) are this workspace's underlays when they
+# exist: catkin then chains them, and `source catkin_ws/devel/setup.bash` alone finds amcl, move_base, gmapping and
+# MoveIt too. A change of underlays needs a fresh configure (catkin caches the chain), so it is stamped like the
+# overlay packages.
 UNDERLAY_STAMP="$WS/devel/.diffbot_underlay"
 underlay=""
-if [ -f "$NAV_SETUP" ] && [ -f "$ROOT/nav_ws/devel/.diffbot_built" ]; then underlay="$ROOT/nav_ws/devel"; fi
+for under in nav_ws moveit_ws; do
+  if [ -f "$ROOT/$under/devel/setup.sh" ] && [ -f "$ROOT/$under/devel/.diffbot_built" ]; then
+    underlay="${underlay:+$underlay }$ROOT/$under/devel"
+  fi
+done
 need_build=""
 if [ ! -f "$WS/devel/setup.bash" ] || [ ! -f "$BUILD_STAMP" ]; then
   need_build=1
@@ -189,7 +199,7 @@ if [ -n "$need_build" ]; then
   log "building $WS with catkin_make"
   t0=$SECONDS
   # shellcheck disable=SC1090
-  (set +eu; if [ -n "$underlay" ]; then . "$NAV_SETUP"; fi
+  (set +eu; extend=""; for under in $underlay; do . "$under/setup.sh" $extend; extend=--extend; done
    cd "$WS" && catkin_make -DPYTHON_EXECUTABLE="$VENV/bin/python" -DCATKIN_ENABLE_TESTING=ON >"$WS/catkin_make.log" 2>&1) || {
     tail -30 "$WS/catkin_make.log"; log "catkin_make failed (log: $WS/catkin_make.log)"; exit 1; }
   touch "$BUILD_STAMP"
