@@ -11,6 +11,8 @@ Suites whose file name starts with `slow_` run only with --slow (`make test-slow
 with `nav_` need the navigation stack (`make nav`) and run only with --nav (`make test-nav`): each twice, at
 real time and in fast mode (rostest arg real_time:=false: as fast as the nodes in the loop allow), fast ones one at a time so that their figures are
 the machine's, not a neighbour's; then the shipped navigation batch (examples/batch/nav.yaml, `--jobs 2`).
+Suites whose name starts with `moveit_` need MoveIt (`make moveit`) and run only with --moveit (`make test-moveit`),
+each at real time and in fast mode, one at a time (move_group plans on the cores the simulator runs on).
 """
 import argparse
 import concurrent.futures
@@ -207,6 +209,9 @@ MULTI_FIXTURES = os.path.join(ROOT, "tests", "data", "multi_way")
 #: A Gazebo user's car-like robots (a bicycle model with Gazebo in its namespace, a SteerBotHardwareGazebo base).
 CAR_FIXTURES = os.path.join(ROOT, "tests", "data", "car_way")
 NAV_NEEDS = ("move_base", "amcl", "map_server", "gmapping", "dwa_local_planner")
+#: What the moveit_ suites launch and import (built by `make moveit` on Debian 12).
+MOVEIT_NEEDS = ("moveit_ros_move_group", "moveit_commander", "moveit_planners_ompl", "moveit_kinematics",
+                "trac_ik_kinematics_plugin", "moveit_simple_controller_manager", "diffbot_arm_moveit_config")
 
 
 def add_package_path(directory):
@@ -246,6 +251,37 @@ def run_nav(args):
     if (not args.only or "batch" in args.only) and args.mode is None:
         p, f, n = run_nav_batch()
         total_p, total_f, failures = total_p + p, total_f + f, failures + n
+    for name in failures:
+        say(f"[tests] FAILED: {name}")
+    say(f"{total_p} passed, {total_f} failed")
+    return 1 if total_f else 0
+
+
+def run_moveit(args):
+    """`make test-moveit`: the moveit_ suites at real time, then in fast mode, one at a time, after checking that
+    `make moveit` has been done."""
+    missing = [p for p in MOVEIT_NEEDS
+               if subprocess.run(["rospack", "find", p], capture_output=True, env=user_env()).returncode != 0]
+    if missing:
+        say(f"[tests] MoveIt is not built (rospack finds no {', '.join(missing)}): run `make moveit` "
+            f"(or `make moveit MOVEIT_SOURCES=DIR` without network) first")
+        say("0 passed, 1 failed")
+        return 1
+    add_package_path(MANIPULATOR_FIXTURES)  # mobile_manipulator_gazebo and its _moveit_config
+    suites = sorted(glob.glob(os.path.join(ROOT, "tests", "integration", "moveit_*.test")))
+    if args.only:
+        suites = [t for t in suites if args.only in os.path.basename(t)]
+    total_p = total_f = 0
+    failures = []
+    for mode in [m for m in ("real_time", "fast") if args.mode in (None, m)]:
+        with cpu_hogs(args.hogs, f"the {mode} suites"):
+            results = _run_suites(suites, mode, 1)
+        for name, p, f, s, n, secs in results:
+            say(f"[tests] rostest {name}: {p} passed, {f} failed ({secs:.0f} s)")
+            for line in _figures(name):
+                say(f"[tests]   {line}")
+            total_p, total_f = total_p + p, total_f + f + s
+            failures += n
     for name in failures:
         say(f"[tests] FAILED: {name}")
     say(f"{total_p} passed, {total_f} failed")
@@ -312,14 +348,18 @@ def main():
     parser.add_argument("--only", default=None, help="run only rostest suites whose name contains this")
     parser.add_argument("--nav", action="store_true",
                         help="run only the navigation suites (nav_*.test; needs `make nav`), at real time and fast")
+    parser.add_argument("--moveit", action="store_true",
+                        help="run only the MoveIt suites (moveit_*.test; needs `make moveit`), at real time and fast")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--mode", choices=("real_time", "fast"), default=None,
-                        help="--nav: only the suites' real-time or fast runs")
+                        help="--nav, --moveit: only the suites' real-time or fast runs")
     parser.add_argument("--hogs", type=int, default=int(os.environ.get("HOGS", "0")),
                         help="this many CPU-bound processes beside the rostest suites (a busy machine, e.g. --only view --hogs 2)")
     args = parser.parse_args()
     if args.nav:
         return run_nav(args)
+    if args.moveit:
+        return run_moveit(args)
     os.makedirs(RESULTS, exist_ok=True)
     add_package_path(MANIPULATOR_FIXTURES)
     add_package_path(MULTI_FIXTURES)
@@ -331,7 +371,7 @@ def main():
         total_p, total_f, total_s = p, f, s
         failures += n
     suites = sorted(t for t in glob.glob(os.path.join(ROOT, "tests", "integration", "*.test"))
-                    if not os.path.basename(t).startswith("nav_"))
+                    if not os.path.basename(t).startswith(("nav_", "moveit_")))
     if not args.slow:
         suites = [t for t in suites if not os.path.basename(t).startswith("slow_")]
     if args.only:
