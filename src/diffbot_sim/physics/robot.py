@@ -66,6 +66,9 @@ class Robot:
             self._link_index[info[12].decode()] = index
         self._apply_surfaces()
         self.free_joints(list(self.joint_index.values()))
+        self._joints = list(range(pybullet.getNumJoints(body, physicsClientId=client)))
+        #: every joint's PyBullet state as of now (``joint_states``), read once after each step or reset
+        self._states = None
 
     def _apply_surfaces(self):
         """Each PyBullet link gets the Gazebo surface of the URDF link it is (lumping only merged links of
@@ -192,9 +195,23 @@ class Robot:
                                            physicsClientId=self.client)
 
     def joint_states(self, indices):
-        """(positions [rad], velocities [rad/s], efforts [N·m]) of the given joints, in one call."""
-        states = pybullet.getJointStates(self.body, indices, physicsClientId=self.client)
-        return [s[0] for s in states], [s[1] for s in states], [s[3] for s in states]
+        """(positions [rad], velocities [rad/s], efforts [N·m]) of the given joints.
+
+        Every joint is read in one call the first time after a step or a reset, and later calls answer from that
+        read: an effort arm's hardware (its write before the step, its read after), its controllers and its
+        mimic plugins all ask each step, and a PyBullet call's fixed cost is most of it. Motor commands given
+        between steps do not change what PyBullet reports until the next step, so the read stays true until
+        :meth:`stepped` (``World.step``) or a reset here forgets it."""
+        states = self._states
+        if states is None:
+            states = self._states = pybullet.getJointStates(self.body, self._joints, physicsClientId=self.client)
+        rows = [states[i] for i in indices]
+        return [s[0] for s in rows], [s[1] for s in rows], [s[3] for s in rows]
+
+    def stepped(self):
+        """The world stepped or was put back (``World.step``, ``World.restore_state``): the joint states read
+        before are stale."""
+        self._states = None
 
     def base_pose(self):
         """Root link frame in the world: ((x, y, z), (qx, qy, qz, qw))."""
@@ -283,16 +300,19 @@ class Robot:
         """Gazebo's Joint::SetVelocity: each joint's velocity [rad/s or m/s] set now, its position kept, no motor
         holding it during the step (free the joints first): friction then acts on a free joint, as in Gazebo."""
         states = pybullet.getJointStates(self.body, indices, physicsClientId=self.client)
+        self._states = None
         for index, state, velocity in zip(indices, states, velocities):
             pybullet.resetJointState(self.body, index, state[0], velocity, physicsClientId=self.client)
 
     def set_joint_positions(self, indices, positions):
         """Joint angles [rad] set at rest (set_model_configuration)."""
+        self._states = None
         for index, position in zip(indices, positions):
             pybullet.resetJointState(self.body, index, position, 0.0, physicsClientId=self.client)
 
     def reset(self):
         """Back to the spawn pose with every joint at 0 and at rest."""
+        self._states = None
         position, orientation = self.spawn
         com = pybullet.multiplyTransforms(position, orientation,
                                           *pybullet.invertTransform(*self._inertial_inv))

@@ -162,13 +162,16 @@ class World:
     def step(self, count=1):
         """``count`` physics steps, nothing else between them (what PyBullet's motors hold stays; torques and
         external forces last one step, so the caller steps one at a time while it applies them). A robot
-        being set down is watched after each."""
+        being set down is watched after each. The robots' joint states read before are stale after it
+        (``Robot.stepped``)."""
         client = self.client
         for _ in range(count):
             pybullet.stepSimulation(physicsClientId=client)
             self.steps += 1
             if self.landing:
                 self.landing.watch()
+        for robot in self.robots:
+            robot.stepped()
 
     def set_solver_iterations(self, iterations):
         """Bullet's constraint solver iterations per step (a world's ``<ode><solver><iters>``, Gazebo's
@@ -316,6 +319,8 @@ class World:
     def restore_state(self, state):
         """Put every body back as snapshot ``state`` (:meth:`save_state`) holds it."""
         snapshots.restore_state(self.client, state)
+        for robot in self.robots:
+            robot.stepped()
 
     def discard_state(self, state):
         """Free snapshot ``state``."""
