@@ -127,6 +127,9 @@ class Pid:
     Args:
         gains: the :class:`PidGains` (replaceable later through :attr:`gains`, as setGains does, without
             resetting the state).
+
+    It runs every physics step for each effort joint, so a computation allocates nothing but the tuple of its
+    terms; :attr:`terms` makes the :class:`PidTerms` from it when asked (a PidState publisher).
     """
 
     def __init__(self, gains: PidGains):
@@ -135,8 +138,20 @@ class Pid:
         self._valid_p_error_last = True
         self._i_error = 0.0
         self._d_error = 0.0
-        self.terms = PidTerms()
+        self._last = None  # the last computation's terms as a tuple (see ``terms``), None: ``_terms`` holds them
+        self._terms = PidTerms()
         self.reset()
+
+    @property
+    def terms(self):
+        """The state of the last computation (or of the last ``reset``): :class:`PidTerms`."""
+        if self._last is not None:
+            dt, error, error_dot, i_error, p_term, i_term, d_term, i_max, i_min, output = self._last
+            self._terms = PidTerms(timestep=dt, error=error, error_dot=error_dot, p_error=error, i_error=i_error,
+                                   d_error=error_dot, p_term=p_term, i_term=i_term, d_term=d_term, i_max=i_max,
+                                   i_min=i_min, output=output)
+            self._last = None
+        return self._terms
 
     def reset(self):
         """Forget the integral and the last error; the next call's derivative is measured from error 0
@@ -145,7 +160,8 @@ class Pid:
         self._i_error = 0.0
         self._d_error = 0.0
         self._valid_p_error_last = True
-        self.terms = PidTerms(i_max=self.gains.i_clamp_max, i_min=self.gains.i_clamp_min)
+        self._last = None
+        self._terms = PidTerms(i_max=self.gains.i_clamp_max, i_min=self.gains.i_clamp_min)
 
     def compute(self, error, dt, error_dot=None):
         """The command for ``error`` over the step ``dt`` (s).
@@ -155,7 +171,7 @@ class Pid:
         error in joint_trajectory_controller). ``dt == 0`` or a non-finite error returns 0.
         """
         if error_dot is None:
-            if dt == 0 or not math.isfinite(error):
+            if dt == 0 or not _isfinite(error):
                 return 0.0
             error_dot = self._d_error
             if dt > 0:
@@ -163,30 +179,34 @@ class Pid:
                     error_dot = (error - self._p_error_last) / dt
                 self._p_error_last = error
                 self._valid_p_error_last = True
-        return self._compute_with_rate(error, error_dot, dt)
-
-    def _compute_with_rate(self, error, error_dot, dt):
-        """``computeCommand(error, error_dot, dt)``: upstream stores the errors before its validity check."""
+        # computeCommand(error, error_dot, dt): upstream stores the errors before its validity check
         gains = self.gains
         self._d_error = error_dot
-        if dt == 0 or not math.isfinite(error) or not math.isfinite(error_dot):
+        if dt == 0 or not _isfinite(error) or not _isfinite(error_dot):
             return 0.0
 
         p_term = gains.p * error
-        self._i_error += dt * error
-        if gains.antiwindup and gains.i != 0:
-            low, high = sorted((gains.i_clamp_min / gains.i, gains.i_clamp_max / gains.i))
-            self._i_error = boost_clamp(self._i_error, low, high)
-        i_term = gains.i * self._i_error
-        if not gains.antiwindup:
-            i_term = boost_clamp(i_term, gains.i_clamp_min, gains.i_clamp_max)
+        i_error = self._i_error + dt * error
+        i_min, i_max = gains.i_clamp_min, gains.i_clamp_max
+        if gains.antiwindup:
+            if gains.i != 0:
+                low, high = sorted((i_min / gains.i, i_max / gains.i))
+                i_error = boost_clamp(i_error, low, high)
+            i_term = gains.i * i_error
+        else:
+            i_term = gains.i * i_error
+            if i_term < i_min:  # boost_clamp(i_term, i_min, i_max)
+                i_term = i_min
+            elif i_max < i_term:
+                i_term = i_max
+        self._i_error = i_error
         d_term = gains.d * error_dot
         output = p_term + i_term + d_term
-
-        self.terms = PidTerms(timestep=dt, error=error, error_dot=error_dot, p_error=error,
-                              i_error=self._i_error, d_error=error_dot, p_term=p_term, i_term=i_term,
-                              d_term=d_term, i_max=gains.i_clamp_max, i_min=gains.i_clamp_min, output=output)
+        self._last = (dt, error, error_dot, i_error, p_term, i_term, d_term, i_max, i_min, output)
         return output
+
+
+_isfinite = math.isfinite
 
 
 #: Share of the stability bound an explicit loop may use before the simulator runs it as an implicit motor
