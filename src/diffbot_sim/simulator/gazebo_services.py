@@ -85,10 +85,13 @@ class GazeboApi:
         for body, force, torque, point in self.wrenches.active(now + self.cfg.time_step):
             model, link = world_api.split_link_name(body)
             entity = self.models().get(model)
-            if entity is None:
+            try:
+                uid, index = entity.body_of(link) if entity is not None else (None, None)
+            except RequestError:  # the model changed since the request (a respawn without a body)
+                uid = None
+            if uid is None:
                 self.wrenches.clear(body)
                 continue
-            uid, index = entity.body_of(link)
             self.sim.world.apply_wrench(uid, index, force, torque, point)
 
     def after_step(self, now, stamp):
@@ -464,6 +467,7 @@ class GazeboApi:
             point = (req.reference_point.x, req.reference_point.y, req.reference_point.z)
             if not all(math.isfinite(v) for v in force + torque + point):
                 raise RequestError("ApplyBodyWrench: wrench and reference_point must be finite")
+            entity.body_of(link)  # a model with no body to push (nothing collides) is refused now, not on the loop
             body_pose = entity.motion(link)[0]
             frame_pose = frame[0] if frame is not None else None
             force, torque, point = world_api.wrench_to_world(force, torque, point, frame_pose, body_pose)

@@ -303,3 +303,15 @@ def test_deleting_a_robot_removes_its_body(api):
     assert api.sim.robots == [] and api.sim.world.robots == []
     hits = api.sim.world.ray_batch([(3.0, 0.0, 2.0)], [(3.0, 0.0, -1.0)])[1]
     assert body not in hits.tolist()  # the ray finds the ground where the arm stood
+
+
+def test_a_wrench_on_a_model_without_a_body_is_refused_and_the_loop_goes_on(api):
+    """A visual-only model (nothing collides, so nothing for the physics to push) is refused when asked, not on
+    the loop's next step, where the error took the loop down."""
+    spawn(api, "marker", box_sdf("marker", collision=False), z=1.0)
+    push = gsrv.ApplyBodyWrenchRequest(body_name="marker::link", wrench=Wrench(Vector3(1, 0, 0), Vector3()),
+                                       duration=genpy.Duration(-1))
+    answer = api._apply_wrench(push)
+    assert not answer.success and "no body to push" in answer.status_message
+    assert len(api.wrenches) == 0
+    steps(api, 0.01)  # the loop's steps raise nothing
