@@ -95,7 +95,8 @@ class GazeboApiTest(unittest.TestCase):
         self.assertTrue(resp.success)
         for name in ("ground_plane", "box_wall", "push_box", "platform"):
             self.assertIn(name, resp.model_names)
-        self.assertGreater(resp.sim_time, 0.0)
+        # the services answer from the start; sim time runs from the loop's first step (once 0.0 here)
+        wait(lambda: self.world().sim_time > 0.0, 10.0, "sim time running")
         box = self.model("push_box")
         self.assertAlmostEqual(box.pose.position.x, 1.15, delta=0.02)
         self.assertAlmostEqual(box.pose.position.y, 15.0, delta=0.02)
