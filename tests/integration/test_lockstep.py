@@ -27,7 +27,46 @@ from simtest import GOAL_MARKER_SDF, Latest, agent_work, wait_for
 from std_srvs.srv import Empty
 
 SCAN_PERIOD = 0.2  # s: laser_robot.urdf's 5 Hz laser
+ODOM_PERIOD = 0.02  # s: its 50 Hz gazebo_ros_diff_drive
+DT = 0.001  # s: the physics step (laser_room.world's max_step_size)
 STEPS = 30
+
+
+class Stamps:
+    """The stamps of every /odom and /scan message (the callbacks only store), to see which came first after a
+    start or a reset_simulation: Gazebo's diff drive (a model plugin) first publishes one period after it
+    (re)starts, its laser (a sensor) first at its period of sim time."""
+
+    def __init__(self):
+        self.lock = threading.Lock()
+        self.stamps = {"odom": [], "scan": []}
+        self.subs = [rospy.Subscriber("/odom", Odometry, self._keep, "odom", queue_size=1000),
+                     rospy.Subscriber("/scan", LaserScan, self._keep, "scan", queue_size=100)]
+
+    def _keep(self, msg, topic):
+        with self.lock:
+            self.stamps[topic].append(msg.header.stamp.to_sec())
+
+    def connected(self):
+        return all(sub.get_num_connections() > 0 for sub in self.subs)
+
+    def clear(self):
+        with self.lock:
+            self.stamps = {"odom": [], "scan": []}
+
+    def first(self, topic, below=math.inf):
+        """The lowest stamp of ``topic`` under ``below`` s (messages of before a reset are stamped higher)."""
+        with self.lock:
+            stamps = [s for s in self.stamps[topic] if s < below]
+        return min(stamps) if stamps else None
+
+    def last(self, topic):
+        with self.lock:
+            return max(self.stamps[topic], default=0.0)
+
+    def close(self):
+        for sub in self.subs:
+            sub.unregister()
 
 
 class Track:
@@ -79,6 +118,31 @@ class Lockstep(unittest.TestCase):
         scan = rospy.wait_for_message("/scan", LaserScan, timeout=30)
         agent_work(work)
         return scan.header.stamp.to_sec()
+
+    def test_0_odometry_comes_before_the_first_scan_after_a_start_and_a_reset(self):
+        """The world starts paused (loop_lockstep.test): the first messages after the start are seen. As in
+        Gazebo, the first odometry is stamped one drive period after the start, the first scan one laser period
+        (0.2 s), and the same after reset_simulation; TurtleBot3's learning environment crashed in its first
+        reset() when a scan came before any odometry."""
+        stamps = Stamps()
+        try:
+            wait_for(stamps.connected, 30, "/odom and /scan connected to this node")
+            rospy.ServiceProxy("/gazebo/unpause_physics", Empty)()
+            for when in ("the start", "reset_simulation"):
+                wait_for(lambda: stamps.first("scan", 0.5) is not None, 30, f"the first scan after {when}")
+                odom, scan = stamps.first("odom", 0.5), stamps.first("scan", 0.5)
+                self.assertIsNotNone(odom, f"no odometry stamped before the first scan after {when}")
+                self.assertTrue(ODOM_PERIOD - 1e-6 <= odom <= ODOM_PERIOD + DT,
+                                f"first odometry after {when} stamped {odom:.4f} s (its period: {ODOM_PERIOD} s)")
+                self.assertAlmostEqual(scan, SCAN_PERIOD, delta=1e-6,
+                                       msg=f"first scan after {when} stamped {scan:.4f} s (its period: 0.2 s)")
+                if when == "the start":
+                    # past 1 s of sim time, so messages of before the reset are told apart by their stamps
+                    wait_for(lambda: stamps.last("scan") >= 1.0, 30, "a scan stamped after 1 s of sim time")
+                    stamps.clear()
+                    self.reset()
+        finally:
+            stamps.close()
 
     def test_1_each_action_is_held_one_scan_period(self):
         self.reset()

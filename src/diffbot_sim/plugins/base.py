@@ -12,7 +12,7 @@ from typing import Optional
 import rospy
 
 from diffbot_sim.config import prefix_frame
-from diffbot_sim.control.schedule import next_due  # noqa: F401 (the plugins' scheduling rule)
+from diffbot_sim.control.schedule import first_due_model, first_due_sensor, next_due  # noqa: F401 (for plugins)
 
 
 def publisher(name, msg_class):
@@ -177,6 +177,9 @@ class Plugin:
     filename = ""
     #: Its publications are sensor data that nodes in the loop answer (``~wait_for_nodes`` waits after them).
     sensor = False
+    #: Timed as a Gazebo ``<sensor>`` (its update timer runs on sim time from 0 and reset_world leaves it alone)
+    #: rather than as a model plugin (first update one period after its start or reset): see :meth:`first_due`.
+    sensor_timer = False
 
     def joints(self):
         """Joints this plugin commands (a joint has one owner)."""
@@ -206,13 +209,25 @@ class Plugin:
     def after_step(self, now, stamp, transforms):
         """Publish what is due; TF transforms go into ``transforms`` (one TFMessage per step)."""
 
-    #: Sim time of the next publication, for plugins that publish on a schedule (``take_due``).
-    next = 0.0
+    #: Sim time of the next publication, for plugins that publish on a schedule (``take_due``); none until
+    #: started.
+    next = math.inf
+    #: Period [s] of that schedule (0: every step), for plugins that keep it here.
+    period = 0.0
 
     def start(self, now):
-        """The loop starts at sim time ``now`` (also after a reset, when sim time may have gone back to 0):
-        schedules start again from ``now``."""
-        self.next = now
+        """The plugin starts at sim time ``now``: the loop's start, a spawn, reset_world or reset_simulation
+        (sim time back to 0). Its first publication is scheduled as Gazebo's (:meth:`first_due`)."""
+        self.next = self.first_due(now, self.period)
+
+    def first_due(self, now, period):
+        """Sim time of the first publication of a schedule of ``period`` after a start at ``now``, Gazebo's one
+        rule for each kind (:mod:`diffbot_sim.control.schedule`): a model plugin one period after its (re)start
+        (gazebo_ros_diff_drive's 30 Hz odometry first at 1/30 s); a sensor at ``period`` on sim time from 0
+        (a 5 Hz laser first at 0.2 s after a start or reset_simulation), its schedule kept by reset_world."""
+        if self.sensor_timer:
+            return first_due_sensor(self.next, period, now)
+        return first_due_model(now, period)
 
     def reset(self, now):
         """Brake and forget pending commands (reset_simulation)."""

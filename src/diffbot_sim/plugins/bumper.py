@@ -72,6 +72,7 @@ class ContactSensor:
 class Bumper(Plugin):
     filename = "libgazebo_ros_bumper.so"
     sensor = True
+    sensor_timer = True
 
     def __init__(self, ctx, contact, topic, frame):
         self.ctx, self.contact, self.frame = ctx, contact, frame
@@ -79,6 +80,9 @@ class Bumper(Plugin):
 
     def publishers(self):
         return [self.pub]
+
+    def start(self, now):
+        self.next = self.first_due(now, self.contact.period)
 
     def after_step(self, now, stamp, transforms):
         if not self.take_due(now, self.contact.period) or not self.pub.get_num_connections():

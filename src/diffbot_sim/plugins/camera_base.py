@@ -15,6 +15,7 @@ class CameraBase(Plugin):
     """What the camera and depth plugins share: the sensor's pose, timing, rendering and CameraInfo."""
 
     sensor = True
+    sensor_timer = True
 
     def __init__(self, ctx, sensor, cfg, tags):
         self.ctx = ctx
@@ -43,7 +44,6 @@ class CameraBase(Plugin):
             ctx.warnings.append(f"{sensor.path}: <update_rate> 0 renders at every physics step (costly); "
                                 "give the sensor a rate")
         self.renderer = choose_renderer(ctx)
-        self.next = 0.0
         self.frame = ctx.frame(self._frame_name())
         self.rng = None
         if cfg.noise_mean or cfg.noise_stddev:

@@ -95,7 +95,7 @@ class GazeboDiffDrive(Plugin):
 
     def start(self, now):
         self.core.start(now)
-        self.next_odom = now
+        self.next_odom = self.first_due(now, self.update_period)
         positions, _, _ = self.ctx.robot.joint_states([self.left_idx[0], self.right_idx[0]])
         self.encoder.reset(positions[0], positions[1], now)
 

@@ -35,6 +35,7 @@ def _frame_rotation(rpy):
 class ForceTorque(Plugin):
     filename = "libgazebo_ros_ft_sensor.so"
     sensor = True
+    sensor_timer = True  # the model plugin too: its last update time starts at 0, not at Load
 
     def __init__(self, ctx, path, joint, topic, frame, period, stddev, rotation=None, sign=1.0):
         self.ctx, self.path, self.joint_name = ctx, path, joint

@@ -102,6 +102,7 @@ def covariance(models):
 
 class Gps(Plugin):
     filename = FILENAME
+    sensor_timer = True  # hector's UpdateTimer updates at multiples of its period on sim time
 
     def __init__(self, ctx, values, path):
         self.ctx, self.v = ctx, values
@@ -122,7 +123,7 @@ class Gps(Plugin):
         return [self.fix_pub, self.vel_pub]
 
     def start(self, now):
-        self.next, self.last_time = now, None
+        self.next, self.last_time = self.first_due(now, self.v["period"]), None
 
     def reset(self, now):
         for model in self.v["position"] + self.v["velocity"]:

@@ -346,6 +346,9 @@ class Reading:
 class ImuPlugin(Plugin):
     def __init__(self, ctx, settings, filename, path):
         self.filename = filename
+        # the IMU sensor's timer, and hector's UpdateTimer (multiples of its period), run on sim time from 0;
+        # gazebo_ros_imu, a model plugin, counts from its Load
+        self.sensor_timer = filename != MODEL_FILENAME
         self.ctx = ctx
         self.s = settings
         try:
@@ -373,7 +376,7 @@ class ImuPlugin(Plugin):
         return [self.pub] + ([self.bias_pub] if self.bias_pub is not None else [])
 
     def start(self, now):
-        self.next, self.last_time, self.velocity = now, None, None
+        self.next, self.last_time, self.velocity = self.first_due(now, self.s.period), None, None
 
     def reset(self, now):
         self.reading.reset()

@@ -169,7 +169,7 @@ class Kobuki(Plugin):
             self.events.update(stamp)
 
     def start(self, now):
-        self.next = self.last_time = now
+        self.next, self.last_time = self.first_due(now, self.period), now
         self._imu_velocity = None
         self.x = self.y = self.yaw = 0.0
 

@@ -80,7 +80,7 @@ class P3D(Plugin):
         return [self.pub]
 
     def start(self, now):
-        self.next = now
+        self.next = self.first_due(now, self.v["period"])
 
     def after_step(self, now, stamp, transforms):
         if not self.take_due(now, self.v["period"]):

@@ -53,6 +53,7 @@ class RaySensorPlugin(Plugin):
     """A ray sensor mounted on a robot link: schedule, pose and casting; subclasses publish."""
 
     sensor = True
+    sensor_timer = True
 
     def __init__(self, ctx, sensor, plugin_element, path):
         self.ctx = ctx

@@ -14,6 +14,7 @@ import math
 
 from sensor_msgs.msg import CameraInfo, Image
 
+from diffbot_sim.control.schedule import first_due_sensor
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import PluginNotLoaded
 from diffbot_sim.messages import common as ros_msgs
@@ -47,7 +48,7 @@ class Stream:
         rate = tag_number(f"<{kind[2]}> of {path}", tags[kind[2]], ctx.warnings, low=0.0) if kind[2] in tags else 0.0
         rate = rate or self.cfg.update_rate
         self.period = 1.0 / rate if rate > 0 else 0.0
-        self.next = 0.0
+        self.next = math.inf  # scheduled when the plugin starts (a camera sensor's timer: first_due_sensor)
         self.frame = ctx.frame(tags.get(kind[5]) or "")
         topic = tags.get(kind[3]) or kind[1]
         info_topic = tags.get(kind[4]) or "camera_info"
@@ -71,6 +72,7 @@ class Stream:
 class RealSense(Plugin):
     filename = "librealsense_gazebo_plugin.so"
     sensor = True
+    sensor_timer = True
 
     def __init__(self, ctx, streams, range_min, range_max):
         self.ctx, self.streams, self.range = ctx, streams, (range_min, range_max)
@@ -83,7 +85,7 @@ class RealSense(Plugin):
 
     def start(self, now):
         for stream in self.streams:
-            stream.next = now
+            stream.next = first_due_sensor(stream.next, stream.period, now)
 
     def after_step(self, now, stamp, transforms):
         for s in self.streams:

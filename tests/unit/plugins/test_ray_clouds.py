@@ -59,7 +59,8 @@ def make(scene, plugin_xml, create):
     spec = type("Spec", (), {"name": "", "tf_prefix": None})()
     ctx = RobotContext(type("Sim", (), {"world": world})(), sim_config({}), spec, model, robot, {}, None, "~")
     plugin = create(ctx, sensor, element.find("plugin"), {})
-    plugin.after_step(0.0, genpy.Time(0, 0), [])
+    plugin.start(0.0)  # as the loop starts it: the first scan one sensor period (0.1 s) on
+    plugin.after_step(0.1, genpy.Time.from_sec(0.1), [])
     return plugin, plugin.pub.sent[-1] if plugin.pub.sent else None
 
 
@@ -111,7 +112,7 @@ def test_in_the_ray_process_a_scan_is_published_when_its_answer_is_back(monkeypa
                     [Shape("box", (0.2, 6.0, 1.0), surface={"laser_retro": 100.0})])
         world.load_world(WorldDescription("w", "test", [wall]), "/nonexistent")
         plugin, _ = make((world, *_robot(world)), VELODYNE, ray_clouds.create_velodyne)
-        assert plugin.pub.sent == [] and plugin.next_publish() == 0.0  # handed over; due again next step
+        assert plugin.pub.sent == [] and plugin.next_publish() == 0.1  # handed over; due again next step
         step, deadline = 0, time.monotonic() + 20.0  # the helper's start (PyBullet's import) is most of it
         while not plugin.pub.sent and time.monotonic() < deadline:
             step += 1
@@ -119,7 +120,7 @@ def test_in_the_ray_process_a_scan_is_published_when_its_answer_is_back(monkeypa
             plugin.after_step(step / 240.0, genpy.Time.from_sec(step / 240.0), [])
             time.sleep(0.004)  # a real-time step
         msg = plugin.pub.sent[0]
-        assert msg.header.stamp == genpy.Time(0, 0)  # as of the step it was due, published later
+        assert msg.header.stamp == genpy.Time.from_sec(0.1)  # as of the step it was due, published later
         pts = cloud(msg)
         assert len(pts) == 24
         np.testing.assert_allclose(pts["x"], FACE, atol=0.01)

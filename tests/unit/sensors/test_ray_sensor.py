@@ -539,9 +539,11 @@ def test_ros2_outputs_publish_from_the_room(room, monkeypatch, output):
     ctx = _Ctx(model)
     ctx.robot, ctx.sim = robot, type("Sim", (), {"world": world})()
     plugin = laser.create_ray_sensor(ctx, lds, element, {})
-    plugin.after_step(0.0, genpy.Time(0, 0), [])
-    plugin.after_step(0.1, genpy.Time(0, 1), [])  # not due (5 Hz)
-    assert len(plugin.pub.sent) == 1 and plugin.next == pytest.approx(0.2)
+    plugin.start(0.0)
+    plugin.after_step(0.1, genpy.Time.from_sec(0.1), [])  # not due: a 5 Hz sensor first scans at 0.2 s
+    assert plugin.pub.sent == []
+    plugin.after_step(0.2, genpy.Time.from_sec(0.2), [])
+    assert len(plugin.pub.sent) == 1 and plugin.next == pytest.approx(0.4)
     msg = plugin.pub.sent[0]
     if output == "sensor_msgs/LaserScan":
         assert len(msg.ranges) == 360 and min(msg.intensities) == 1.0  # clipped up to min_intensity

@@ -4,6 +4,7 @@ wheels, casters, fingers a mimic plugin moves: robot_state_publisher needs them 
 positions make TF agree with the body), and ``extra_joints`` with their fixed values."""
 from sensor_msgs.msg import JointState
 
+from diffbot_sim.control.schedule import first_due_model
 from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.plugins.base import join, next_due
 from diffbot_sim.plugins.ros_control.controller import Controller
@@ -39,8 +40,10 @@ class JointStateController(Controller):
         return [self.pub]
 
     def start(self, now):
+        """joint_state_controller's starting() (0.21.2, Noetic's last release): its last publication time is
+        ``now``, so the first message comes one period later."""
         super().start(now)
-        self.next = now
+        self.next = first_due_model(now, self.period)
 
     def update(self, now, period, stamp, transforms):
         if now + 1e-9 < self.next:  # its own schedule within the control period
