@@ -40,6 +40,8 @@ EFFORT, POSITION, POSITION_PID, VELOCITY, VELOCITY_PID = (
 #: PyBullet's position gain for a POSITION joint: the motor removes the whole position error each step, the
 #: nearest a constraint comes to Gazebo's SetPosition.
 KINEMATIC_POSITION_GAIN = 1.0
+_PI, _TWO_PI = math.pi, 2.0 * math.pi
+_fmod, _isfinite = math.fmod, math.isfinite
 
 
 @dataclass
@@ -193,20 +195,24 @@ class RobotHWSim:
         self.estop = active
 
     # -- readSim / writeSim -------------------------------------------------------------------------------
+    # Both run every physics step for an effort arm: one pass over the joints each, the angle unwrapping
+    # (``joint.position + shortest_angular_distance(joint.position, raw)``) written out with the same arithmetic.
     def read(self):
         """readSim: positions (unwrapped for revolute/continuous joints), velocities, efforts."""
         if not self._order:
             return
         positions, velocities, torques = self.ctx.robot.joint_states(self._indices)
         for joint, raw, velocity, torque in zip(self._order, positions, velocities, torques):
-            if joint.position is None or joint.joint_type == "prismatic":
+            previous = joint.position
+            if previous is None or joint.joint_type == "prismatic":
                 joint.position = raw
             else:
-                joint.position += shortest_angular_distance(joint.position, raw)
+                delta = _fmod(raw - previous + _PI, _TWO_PI)
+                joint.position = previous + (delta + _PI if delta <= 0.0 else delta - _PI)
             joint.velocity = velocity
             if joint.implicit or joint.target_mode is not None:
                 joint.effort = torque
-            elif not joint.torque_driven:
+            elif not (joint.method == EFFORT or joint.pid is not None):  # not torque-driven
                 joint.effort = 0.0
 
     def start(self):
@@ -231,37 +237,59 @@ class RobotHWSim:
         positions, velocities, _ = robot.joint_states(self._indices)
         torques, torque_idx = [], []
         busy = False
+        estop = self.estop
         for joint, raw, velocity in zip(self._order, positions, velocities):
-            position = raw if joint.position is None or joint.joint_type == "prismatic" else \
-                joint.position + shortest_angular_distance(joint.position, raw)
-            command = self._command(joint)
-            if joint.target_mode is not None:
+            previous = joint.position
+            if previous is None or joint.joint_type == "prismatic":
+                position = raw
+            else:
+                delta = _fmod(raw - previous + _PI, _TWO_PI)
+                position = previous + (delta + _PI if delta <= 0.0 else delta - _PI)
+            command = self._command(joint) if estop else joint.command
+            mode = joint.target_mode
+            if mode is not None:
                 force = joint.motor_force if joint.target_force is None else joint.target_force
-                if joint.target_mode == "position":
-                    self._push(joint, ("p", command, force),
-                               lambda: robot.set_positions([joint.index], [command], [force]))
-                else:
-                    self._push(joint, ("v", command, force),
-                               lambda: robot.set_velocities([joint.index], [command], [force]))
+                setting = ("p" if mode == "position" else "v", command, force)
+                if joint.pushed != setting:  # motor targets persist in PyBullet: given only when changed
+                    if mode == "position":
+                        robot.set_positions([joint.index], [command], [force])
+                    else:
+                        robot.set_velocities([joint.index], [command], [force])
+                    joint.pushed = setting
                 continue
-            if joint.limit_handle is not None:
-                wanted = command
-                command = joint.limit_handle.enforce(command, position, velocity, dt)
-                busy = busy or command != wanted
-            if joint.torque_driven:
+            handle = joint.limit_handle
+            if handle is not None:
+                limited = handle.enforce(command, position, velocity, dt)
+                if limited != command:
+                    busy = True
+                command = limited
+            method = joint.method
+            if method == EFFORT or joint.pid is not None:  # torque-driven
                 busy = True
-                effort = command if joint.method == EFFORT else self._pid_effort(joint, command, position, velocity, dt)
-                effort = _truncate(effort, velocity, joint)
+                effort = command if method == EFFORT else self._pid_effort(joint, command, position, velocity, dt)
+                # _truncate, written out
+                limit = joint.velocity_limit
+                if velocity > limit and effort > 0 or velocity < -limit and effort < 0:
+                    effort = 0.0
+                else:
+                    limit = joint.effort_limit
+                    if _isfinite(limit):
+                        effort = max(-limit, min(limit, effort))
                 joint.effort = effort
                 torques.append(effort)
                 torque_idx.append(joint.index)
-            elif joint.method in (POSITION, POSITION_PID):
-                self._push(joint, ("p", command), lambda: robot.set_positions(
-                    [joint.index], [command], [joint.motor_force if joint.implicit else UNLIMITED_EFFORT],
-                    None if joint.implicit else KINEMATIC_POSITION_GAIN))
+            elif method == POSITION or method == POSITION_PID:
+                setting = ("p", command)
+                if joint.pushed != setting:
+                    robot.set_positions([joint.index], [command],
+                                        [joint.motor_force if joint.implicit else UNLIMITED_EFFORT],
+                                        None if joint.implicit else KINEMATIC_POSITION_GAIN)
+                    joint.pushed = setting
             else:
-                self._push(joint, ("v", command), lambda: robot.set_velocities(
-                    [joint.index], [command], [joint.motor_force]))
+                setting = ("v", command)
+                if joint.pushed != setting:
+                    robot.set_velocities([joint.index], [command], [joint.motor_force])
+                    joint.pushed = setting
         if torque_idx:
             robot.set_efforts(torque_idx, torques)
         self.busy = busy
@@ -283,13 +311,6 @@ class RobotHWSim:
         else:
             error = command - position
         return joint.pid.compute(error, dt)
-
-    @staticmethod
-    def _push(joint, setting, apply):
-        """Motor targets persist in PyBullet: give one only when it changed."""
-        if joint.pushed != setting:
-            apply()
-            joint.pushed = setting
 
 
 def _truncate(effort, velocity, joint):
