@@ -21,9 +21,10 @@ message is read against the *next* update (last update's time + period), whateve
 the ``time`` arguments of ``goal``/``command``/``cancel``/``stopping`` do not move anything (kept for the
 caller's symmetry); ``query_state``'s ``time`` is the requested sample time.
 """
+import bisect
+import math
 from typing import Hashable, NamedTuple, Optional, Tuple
 
-from diffbot_sim.control.angles import shortest_angular_distance
 from diffbot_sim.control.joint_trajectory_config import JtcConfig
 from diffbot_sim.control.pid import Pid
 from diffbot_sim.control.trajectory import (
@@ -37,6 +38,9 @@ from diffbot_sim.control.trajectory import (
     to_sec,
 )
 from diffbot_sim.errors import DiffbotSimError
+
+_PI, _TWO_PI = math.pi, 2.0 * math.pi
+_fmod, _bisect_right = math.fmod, bisect.bisect_right
 
 # control_msgs/FollowJointTrajectoryResult error codes.
 SUCCESSFUL = 0
@@ -121,7 +125,9 @@ class JointTrajectoryControllerCore:
         self._running = False
         # Upstream's TimeData, in ns as ros::Time: last update's time and period, and the uptime.
         self._time_ns = self._period_ns = self._uptime_ns = 0
-        self._trajectory = ()
+        self._set_trajectory(())
+        self._zeros = (0.0,) * n
+        self._state_period_ns = to_ns(1.0 / cfg.state_publish_rate) if cfg.state_publish_rate else None
         self._active_goal = None
         self._done = set()  # joints inside the goal tolerance; upstream's successful_joint_traj_
         self._desired = ([0.0] * n, [0.0] * n, [0.0] * n)
@@ -129,6 +135,11 @@ class JointTrajectoryControllerCore:
         self._last_state_publish_ns = 0
         self._pending = []  # goals preempted by a topic command, reported by the next update
         self._log = list(cfg.log)
+
+    def _set_trajectory(self, trajectory):
+        """The trajectory to follow, with each joint's segment start times (``findSegment``'s bisection)."""
+        self._trajectory = trajectory
+        self._starts = [[segment.start_time for segment in segments] for segments in trajectory]
 
     @property
     def active_goal(self):
@@ -185,8 +196,7 @@ class JointTrajectoryControllerCore:
         self._uptime_ns += self._period_ns
         self._measure(positions, velocities)
         indexes, desired, actual, error = self._update_states()
-        events = list(self._pending)
-        self._pending = []
+        events, self._pending = self._pending, []
         if any(index is None for index in indexes):  # unreachable while uptime grows: upstream returns
             self._log.append(("error", "Unexpected error: No trajectory defined at current time. "
                                        "Please contact the package maintainer."))
@@ -208,34 +218,47 @@ class JointTrajectoryControllerCore:
 
     def _update_states(self):
         """``updateStates``: desired from the trajectory at the uptime, errors with the angular distance
-        (for every joint type, as upstream), time_from_start from the first joint's segment."""
-        samples, indexes = [], []
+        (for every joint type, as upstream), time_from_start from the first joint's segment.
+
+        It runs at every update of every joint (every physics step for the effort variant), so the sampling
+        (``trajectory.sample``: the last segment starting at or before the uptime, or the first) and
+        ``shortest_angular_distance`` are written out here with the same arithmetic."""
         uptime = to_sec(self._uptime_ns)
-        for segments in self._trajectory:
-            index, state = sample(segments, uptime)
-            indexes.append(index)
-            samples.append(state)
         positions, velocities = self._measured
-        self._desired = ([s.position for s in samples], [s.velocity for s in samples],
-                         [s.acceleration for s in samples])
+        indexes, desired_p, desired_v, desired_a, error_p, error_v = [], [], [], [], [], []
+        for segments, starts, position, velocity in zip(self._trajectory, self._starts, positions, velocities):
+            if uptime < starts[0]:
+                index = None
+                p, v, a = segments[0].values(uptime)
+            else:
+                index = _bisect_right(starts, uptime) - 1
+                p, v, a = segments[index].values(uptime)
+            indexes.append(index)
+            desired_p.append(p)
+            desired_v.append(v)
+            desired_a.append(a)
+            delta = _fmod(p - position + _PI, _TWO_PI)
+            error_p.append(delta + _PI if delta <= 0.0 else delta - _PI)
+            error_v.append(v - velocity)
+        self._desired = (desired_p, desired_v, desired_a)
         first = self._trajectory[0][indexes[0] if indexes[0] is not None else 0]
         actual_tfs = uptime - first.start_time + first.time_from_start
-        n = len(samples)
-        desired = TrajectoryState(*map(tuple, self._desired), first.time_from_start)
-        actual = TrajectoryState(tuple(positions), tuple(velocities), (0.0,) * n, actual_tfs)
-        error = TrajectoryState(
-            tuple(shortest_angular_distance(p, s.position) for p, s in zip(positions, samples)),
-            tuple(s.velocity - v for v, s in zip(velocities, samples)), (0.0,) * n,
-            first.time_from_start - actual_tfs)
+        zeros = self._zeros
+        desired = TrajectoryState(tuple(desired_p), tuple(desired_v), tuple(desired_a), first.time_from_start)
+        actual = TrajectoryState(tuple(positions), tuple(velocities), zeros, actual_tfs)
+        error = TrajectoryState(tuple(error_p), tuple(error_v), zeros, first.time_from_start - actual_tfs)
         return indexes, desired, actual, error
 
     def _check_tolerances(self, indexes, error):
         """Path tolerances while a segment of the active goal runs, goal tolerances once its last segment
         has ended (with ``goal_time`` of grace). Returns the abort, if any."""
+        goal = self._active_goal
+        if goal is None:  # only the active goal's segments are checked
+            return []
         uptime = to_sec(self._uptime_ns)
         for joint, (segments, index) in enumerate(zip(self._trajectory, indexes)):
             segment = segments[index]
-            if self._active_goal is None or segment.owner != self._active_goal:
+            if segment.owner != goal:
                 continue
             tolerances = segment.tolerances
             position_error, velocity_error = error.positions[joint], error.velocities[joint]
@@ -261,14 +284,16 @@ class JointTrajectoryControllerCore:
         if self.cfg.variant == "position":
             return desired.positions
         period = to_sec(self._period_ns)
-        return tuple(ff * velocity + pid.compute(position_error, period, error_dot=velocity_error)
-                     for ff, velocity, pid, position_error, velocity_error
-                     in zip(self.cfg.velocity_ff, desired.velocities, self._pids, error.positions,
-                            error.velocities))
+        return tuple([ff * velocity + pid.compute(position_error, period, velocity_error)
+                      for ff, velocity, pid, position_error, velocity_error
+                      in zip(self.cfg.velocity_ff, desired.velocities, self._pids, error.positions,
+                             error.velocities)])
 
     def _state_due(self):
         """``publishState``: due once more than a publish period has passed since the last slot."""
-        period_ns = to_ns(1.0 / self.cfg.state_publish_rate)
+        period_ns = self._state_period_ns
+        if period_ns is None:
+            period_ns = to_ns(1.0 / self.cfg.state_publish_rate)
         if self._last_state_publish_ns + period_ns < self._uptime_ns:
             self._last_state_publish_ns += period_ns
             return True
@@ -280,8 +305,8 @@ class JointTrajectoryControllerCore:
             positions, velocities = self._measured
         else:
             positions, velocities = self._desired[0], self._desired[1]
-        self._trajectory = hold_trajectory(to_sec(start_uptime_ns), positions, velocities,
-                                           self.cfg.stop_trajectory_duration, owner)
+        self._set_trajectory(hold_trajectory(to_sec(start_uptime_ns), positions, velocities,
+                                             self.cfg.stop_trajectory_duration, owner))
 
     def _preempt_active_goal(self):
         goal, self._active_goal = self._active_goal, None
@@ -307,7 +332,7 @@ class JointTrajectoryControllerCore:
             self._log.append(("warn", merged.warning))
         if not merged.trajectory:
             return ""
-        self._trajectory = merged.trajectory
+        self._set_trajectory(merged.trajectory)
         return None
 
     def goal(self, goal_id, joint_names, points, stamp=0.0, path_tolerances=(), goal_tolerances=(),

@@ -90,9 +90,8 @@ class StateTolerances:
 
     def violated(self, position_error, velocity_error, acceleration_error=0.0):
         """True when a checked component's |error| exceeds its tolerance (``checkStateTolerancePerJoint``)."""
-        checks = ((self.position, position_error), (self.velocity, velocity_error),
-                  (self.acceleration, acceleration_error))
-        return any(tol > 0.0 and abs(err) > tol for tol, err in checks)
+        return (0.0 < self.position < abs(position_error) or 0.0 < self.velocity < abs(velocity_error)
+                or 0.0 < self.acceleration < abs(acceleration_error))
 
 
 @dataclass(frozen=True)
@@ -139,11 +138,16 @@ def _coefficients(start, end, duration):
             (-12.0 * p0 + 12.0 * p1 - a0 * T2 + a1 * T2 - 6.0 * v0 * T - 6.0 * v1 * T) / (2.0 * T ** 5))
 
 
-def _polynomial(c, t):
+def _polynomial_values(c, t):
+    """(position, velocity, acceleration) of the polynomial ``c`` at ``t``: a plain tuple."""
     position = c[0] + t * (c[1] + t * (c[2] + t * (c[3] + t * (c[4] + t * c[5]))))
     velocity = c[1] + t * (2.0 * c[2] + t * (3.0 * c[3] + t * (4.0 * c[4] + t * 5.0 * c[5])))
     acceleration = 2.0 * c[2] + t * (6.0 * c[3] + t * (12.0 * c[4] + t * 20.0 * c[5]))
-    return JointSample(position, velocity, acceleration)
+    return position, velocity, acceleration
+
+
+def _polynomial(c, t):
+    return JointSample(*_polynomial_values(c, t))
 
 
 @dataclass(frozen=True)
@@ -182,12 +186,16 @@ class Segment:
 
     def sample(self, time):
         """The state at ``time``; before the start or after the end: that end's position, at rest."""
+        return JointSample(*self.values(time))
+
+    def values(self, time):
+        """:meth:`sample` as a plain (position, velocity, acceleration) tuple (the controller's every update)."""
         t = time - self.start_time
         if t < 0.0:
-            return JointSample(self.coefficients[0], 0.0, 0.0)
+            return self.coefficients[0], 0.0, 0.0
         if t > self.duration:
-            return JointSample(_polynomial(self.coefficients, self.duration).position, 0.0, 0.0)
-        return _polynomial(self.coefficients, t)
+            return _polynomial_values(self.coefficients, self.duration)[0], 0.0, 0.0
+        return _polynomial_values(self.coefficients, t)
 
     def owned_by(self, owner):
         return dataclasses.replace(self, owner=owner)
