@@ -172,13 +172,23 @@ class MimicCore:
         Args:
             master_position, mimic_position: joint positions now (rad or m). dt: the physics max step size (s).
         """
+        if self._pid is not None:
+            effort = self.effort(master_position, mimic_position, dt)
+            return None if effort is None else MimicAction("effort", effort)
         target = self.target(master_position)
         if not abs(target - mimic_position) >= self.config.sensitiveness:
             return None
-        if self._pid is None:
-            return MimicAction("position", target)
-        limit = self.config.max_effort
-        return MimicAction("effort", ignition_clamp(self._pid.compute(target - mimic_position, dt), -limit, limit))
+        return MimicAction("position", target)
+
+    def effort(self, master_position, mimic_position, dt) -> Optional[float]:
+        """With ``<hasPID>``: :meth:`update`'s effort (N·m or N) as a number, or None when it does nothing (the
+        plugin's every step, without building an action)."""
+        config = self.config
+        target = master_position * config.multiplier + config.offset
+        if not abs(target - mimic_position) >= config.sensitiveness:
+            return None
+        limit = config.max_effort
+        return max(min(self._pid.compute(target - mimic_position, dt), limit), -limit)  # ignition_clamp
 
 
 def urdf_mimic_target(master_position, mimic):

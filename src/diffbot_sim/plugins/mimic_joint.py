@@ -57,9 +57,9 @@ class MimicJoint(Plugin):
                 robot.set_positions([self.mimic], [target], [self.force],
                                     KINEMATIC_POSITION_GAIN if not self.core.config.has_pid else None)
             return
-        action = self.core.update(master, mimic, self.ctx.cfg.time_step)
-        if action is not None:
-            robot.set_efforts([self.mimic], [action.value])
+        effort = self.core.effort(master, mimic, self.ctx.cfg.time_step)
+        if effort is not None:
+            robot.set_efforts([self.mimic], [effort])
 
     def summary(self):
         cfg = self.cfg
