@@ -34,10 +34,13 @@ class GraspFix(Plugin):
 
     def after_step(self, now, stamp, transforms):
         robot, world = self.ctx.robot, self.ctx.sim.world
-        dynamic = {uid for uid, body in world.world_bodies if not body.static}
-        dynamic |= {r.body for r in world.robots if r is not robot}
+        touching = robot.link_contacts(self.links)  # most steps: none, and nothing more to do until a decision
+        dynamic = set()
+        if touching:
+            dynamic = {uid for uid, body in world.world_bodies if not body.static}
+            dynamic |= {r.body for r in world.robots if r is not robot}
         step = {}
-        for link, other, other_link, point, force in robot.link_contacts(self.links):
+        for link, other, other_link, point, force in touching:
             if other in dynamic:
                 entry = step.setdefault((link, (other, other_link)), ([], []))
                 entry[0].append(point)
