@@ -66,6 +66,7 @@ class ControllerManager:
         self.next_update = 0.0
         self.last_update = None
         self.last_step_update = None
+        self._step_running, self._step_controllers = None, []  # see _every_step
 
     def full_name(self, name):
         return join(self.ns, name)
@@ -169,14 +170,23 @@ class ControllerManager:
         for controller in self.running:
             controller.start(now)
 
+    def _every_step(self):
+        """The running controllers that run at every physics step, found again only when the running set changed
+        (the loop asks every step)."""
+        if self.running != self._step_running:
+            self._step_running = list(self.running)
+            self._step_controllers = [c for c in self.running if self.period is None and getattr(c, "closed_loop",
+                                                                                                  False)]
+        return self._step_controllers
+
     def step_due(self):
         """Whether a controller runs at every physics step."""
-        return self.period is None and any(getattr(c, "closed_loop", False) for c in self.running)
+        return bool(self._every_step())
 
     def update(self, now, stamp, transforms):
         """Run the controllers that are due at sim time ``now``."""
         slow_due = now + 1e-9 >= self.next_update
-        every_step = [c for c in self.running if self.period is None and getattr(c, "closed_loop", False)]
+        every_step = self._every_step()
         if not slow_due and not every_step:
             return
         self.hw.read()
