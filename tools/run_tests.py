@@ -364,6 +364,7 @@ def main():
     add_package_path(MANIPULATOR_FIXTURES)
     add_package_path(MULTI_FIXTURES)
     add_package_path(CAR_FIXTURES)
+    add_package_path(os.path.join(ROOT, "tests", "data", "arm_way"))  # fixed arms of published shapes: arm_way_*
     total_p = total_f = total_s = 0
     failures = []
     if args.only is None:
