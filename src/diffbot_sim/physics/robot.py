@@ -208,6 +208,13 @@ class Robot:
         rows = [states[i] for i in indices]
         return [s[0] for s in rows], [s[1] for s in rows], [s[3] for s in rows]
 
+    def joint_positions(self, indices):
+        """Positions [rad or m] of the given joints (:meth:`joint_states`' first list, from the same read)."""
+        states = self._states
+        if states is None:
+            states = self._states = pybullet.getJointStates(self.body, self._joints, physicsClientId=self.client)
+        return [states[i][0] for i in indices]
+
     def stepped(self):
         """The world stepped or was put back (``World.step``, ``World.restore_state``): the joint states read
         before are stale."""

@@ -27,6 +27,7 @@ class MimicJoint(Plugin):
         self.ctx, self.cfg, self.filename = ctx, cfg, filename
         robot = ctx.robot
         self.master, self.mimic = robot.indices([cfg.joint, cfg.mimic_joint])
+        self.pair = [self.master, self.mimic]
         gains = pid_gains(get_param(cfg.pid_namespace, None), cfg.pid_namespace) if cfg.has_pid else None
         self.core = MimicCore(cfg, gains)
         self.motor = not cfg.has_pid  # a position motor (kinematic, or standing in for an unstable PID)
@@ -50,7 +51,7 @@ class MimicJoint(Plugin):
 
     def before_step(self, now):
         robot = self.ctx.robot
-        (master, mimic), _, _ = robot.joint_states([self.master, self.mimic])
+        master, mimic = robot.joint_positions(self.pair)
         if self.motor:
             target = self.core.target(master)
             if math.isfinite(target) and abs(target - mimic) >= self.core.config.sensitiveness:
@@ -83,7 +84,7 @@ class UrdfMimic(Plugin):
 
     def before_step(self, now):
         robot = self.ctx.robot
-        masters, _, _ = robot.joint_states([m for m, _, _ in self.couplings])
+        masters = robot.joint_positions([m for m, _, _ in self.couplings])
         for (master, mimic, spec), position in zip(self.couplings, masters):
             robot.set_positions([mimic], [urdf_mimic_target(position, spec)], [UNLIMITED_EFFORT],
                                 KINEMATIC_POSITION_GAIN)
