@@ -41,6 +41,7 @@ from diffbot_sim.errors import DiffbotSimError
 
 _PI, _TWO_PI = math.pi, 2.0 * math.pi
 _fmod, _bisect_right = math.fmod, bisect.bisect_right
+_tuple_new = tuple.__new__
 
 # control_msgs/FollowJointTrajectoryResult error codes.
 SUCCESSFUL = 0
@@ -197,7 +198,7 @@ class JointTrajectoryControllerCore:
         self._measure(positions, velocities)
         indexes, desired, actual, error = self._update_states()
         events, self._pending = self._pending, []
-        if any(index is None for index in indexes):  # unreachable while uptime grows: upstream returns
+        if None in indexes:  # unreachable while uptime grows: upstream returns
             self._log.append(("error", "Unexpected error: No trajectory defined at current time. "
                                        "Please contact the package maintainer."))
             return JtcUpdate(None, desired, actual, error, tuple(events), False, None)
@@ -243,10 +244,12 @@ class JointTrajectoryControllerCore:
         self._desired = (desired_p, desired_v, desired_a)
         first = self._trajectory[0][indexes[0] if indexes[0] is not None else 0]
         actual_tfs = uptime - first.start_time + first.time_from_start
-        zeros = self._zeros
-        desired = TrajectoryState(tuple(desired_p), tuple(desired_v), tuple(desired_a), first.time_from_start)
-        actual = TrajectoryState(tuple(positions), tuple(velocities), zeros, actual_tfs)
-        error = TrajectoryState(tuple(error_p), tuple(error_v), zeros, first.time_from_start - actual_tfs)
+        zeros = self._zeros  # TrajectoryStates made by tuple.__new__: the named constructor's frame costs more
+        desired = _tuple_new(TrajectoryState, (tuple(desired_p), tuple(desired_v), tuple(desired_a),
+                                               first.time_from_start))
+        actual = _tuple_new(TrajectoryState, (tuple(positions), tuple(velocities), zeros, actual_tfs))
+        error = _tuple_new(TrajectoryState, (tuple(error_p), tuple(error_v), zeros,
+                                             first.time_from_start - actual_tfs))
         return indexes, desired, actual, error
 
     def _check_tolerances(self, indexes, error):

@@ -161,8 +161,8 @@ class JointTrajectoryController(Controller):
             self._finish(event)
 
     def update(self, now, period, stamp, transforms):
-        joints = self.cfg.joints
-        result = self.core.update(now, period, self.hw.positions(joints), self.hw.velocities(joints))
+        joints, hw = self.cfg.joints, self.hw
+        result = self.core.update(now, period, hw.positions(joints), hw.velocities(joints))
         self._flush_log()
         if result.commands is not None:
             self._write(result.commands, result.desired.positions)
@@ -190,10 +190,12 @@ class JointTrajectoryController(Controller):
     def _write(self, commands, desired_positions):
         """The adapter's commands, or for a joint run by position targets (``by_position``) its desired
         position."""
+        by_position, set_command = self.by_position, self.hw.set_command
         for joint, value, desired in zip(self.cfg.joints, commands, desired_positions):
-            value = desired if joint in self.by_position else value
+            if joint in by_position:
+                value = desired
             if math.isfinite(value):
-                self.hw.set_command(joint, value)
+                set_command(joint, value)
 
     def summary(self):
         return {f"{self.name}/action": join(self.name, "follow_joint_trajectory")}
