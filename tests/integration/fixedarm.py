@@ -43,6 +43,8 @@ from diffbot_sim.transforms import compose, rpy_quaternion
 
 #: m, rad: a base bolted to the world stays this close to where it was spawned
 BASE_DISTANCE, BASE_ANGLE = 0.001, 0.002
+#: s (wall) a suite that presses play waits for the spawner to have started the controllers while paused
+START_WHILE_PAUSED = 10.0
 #: Share of a joint's effort limit that the force along its motion may reach while it is over its velocity limit
 PUSH_SHARE = 0.25
 #: An interval counts as over the limit when the joint is this many times its limit at both ends (nearer the
@@ -287,12 +289,21 @@ class FixedArmCase(unittest.TestCase):
         listing = _proxy(f"{ns}/controller_manager/list_controllers", ListControllers)
         wanted = set(running) | set(stopped)
         wait_for(lambda: {c.name for c in listing().controller} >= wanted, 90, f"{sorted(wanted)} loaded")
-        if unpause:
-            _proxy("/gazebo/unpause_physics", Empty)()
         states = dict.fromkeys(running, "running")
         states.update(dict.fromkeys(stopped, "stopped"))
-        wait_for(lambda: {c.name: c.state for c in listing().controller} == states, 90,
-                 f"the controllers in their states {states}")
+
+        def in_their_states():
+            return {c.name: c.state for c in listing().controller} == states
+        if unpause:
+            # Play is pressed once the spawner has started the controllers, so that the arm never hangs limp:
+            # they are running at once where a switch is served while paused; where it waits for the first
+            # step after play (as gazebo_ros_control's controller manager does), after this deadline.
+            try:
+                wait_for(in_their_states, START_WHILE_PAUSED, "the controllers started while paused")
+            except AssertionError:
+                pass
+            _proxy("/gazebo/unpause_physics", Empty)()
+        wait_for(in_their_states, 90, f"the controllers in their states {states}")
         description, joint_states = f"{ns}/robot_description", f"{ns}/joint_states"
         if controller:
             cls.arm = Arm(f"{ns}/{controller}", model_name, description=description, joint_states=joint_states)
