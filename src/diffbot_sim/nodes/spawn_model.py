@@ -18,6 +18,7 @@ refused call (its status_message logged), one line naming the flag, file, parame
 """
 import sys
 import threading
+import time
 
 import rospy
 from gazebo_msgs.msg import ModelStates
@@ -157,8 +158,14 @@ def _spawn(args, model_xml):
     rospy.loginfo(f"Spawn status: {resp.status_message}")
 
 
+#: Wall seconds upstream's spawn_model sleeps before set_model_configuration ("temporary hack",
+#: gazebo_ros_pkgs issue 93): launch files are timed with it (a paused world is unpaused after it).
+CONFIGURATION_DELAY = 1.0
+
+
 def _set_configuration(args):
     service, configure = _proxy(args, "set_model_configuration", SetModelConfiguration)
+    time.sleep(CONFIGURATION_DELAY)
     names = [name for name, _ in args.joints]
     request = SetModelConfigurationRequest(
         model_name=args.model, urdf_param_name=args.source_value if args.source == "param" else "",

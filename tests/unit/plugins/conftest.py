@@ -82,6 +82,7 @@ class Sim:
     def __init__(self, world):
         self.world = world
         self.sim_time = 0.0
+        self.paused = False
         self.wake = SimpleNamespace(set=lambda: None)
         self.warned = []
 

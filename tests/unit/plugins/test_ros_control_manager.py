@@ -281,3 +281,32 @@ def test_reload_libraries_needs_force_kill_while_controllers_are_loaded(services
     assert len(cm.loaded) == 2
     assert call["reload_controller_libraries"](cm_srv.ReloadControllerLibrariesRequest(force_kill=True)).ok
     assert cm.loaded == {} and cm.running == []
+
+
+def test_a_switch_asked_while_paused_waits_for_the_first_step_and_starts_from_the_pose_set_meanwhile(services):
+    """A Gazebo launch spawns paused, ``spawn_model -J`` sets the arm's pose, the spawner switches its controllers
+    on and the world is unpaused. Upstream's switch service waits for the realtime loop's next update, so the
+    controller starts holding the -J pose. Here the switch waits likewise (it used to run at once while paused,
+    so the controller held the pose before -J and pulled the arm back to it)."""
+    import threading
+
+    arm, cm, _, call = services
+    assert call["load_controller"](cm_srv.LoadControllerRequest(name="arm_controller")).ok
+    arm.sim.paused = True
+    answers = []
+    switch = threading.Thread(target=lambda: answers.append(call["switch_controller"](
+        cm_srv.SwitchControllerRequest(start_controllers=["arm_controller"], strictness=STRICT))))
+    switch.start()
+    switch.join(0.3)
+    assert switch.is_alive() and cm.pending  # waits while paused
+    (state,) = call["list_controllers"](cm_srv.ListControllersRequest()).controller
+    assert state.state != "running"
+    pose = [0.4, -0.3, 0.5]
+    arm.robot.set_joint_positions(arm.robot.indices(GROUP["joints"]), pose)  # -J, while paused
+    arm.sim.paused = False
+    cm.run_pending(arm.sim.sim_time)  # the plugin's before_step at the first step after the unpause
+    switch.join(2.0)
+    assert answers and answers[0].ok
+    run(arm, cm.hw, cm, 0.5)
+    for joint, want in zip(GROUP["joints"], pose):
+        assert arm.joint(joint)[0] == pytest.approx(want, abs=1e-3)  # held where -J put it

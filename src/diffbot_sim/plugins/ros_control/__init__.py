@@ -52,12 +52,14 @@ class RosControl(Plugin):
     def next_control(self):
         """Every step while the hardware has work (torques, a limit still clipping, a new command); a robot whose
         joints are all PyBullet motors holding their targets has none until a controller's next update."""
-        return self.ctx.sim.sim_time if self.hw.busy or self._estop is not None else math.inf
+        return self.ctx.sim.sim_time if self.hw.busy or self._estop is not None or self.manager.pending else math.inf
 
     def next_publish(self):
         return self.ctx.sim.sim_time if self.manager.step_due() else self.manager.next_update
 
     def before_step(self, now):
+        if self.manager.pending:  # switches asked for while paused: at the first step after the unpause
+            self.manager.run_pending(now)
         if self._estop is not None:
             active, self._estop = self._estop, None
             released = self.hw.estop and not active

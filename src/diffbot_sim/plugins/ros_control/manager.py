@@ -10,6 +10,8 @@ trajectory controllers, PID controllers, the effort gripper) run every physics s
 (``controlPeriod`` = the step), and the others every CONTROL_PERIOD: they hand targets to motors that hold
 them between updates, so a slower update changes nothing but the CPU spent.
 """
+import threading
+
 import rospy
 
 from diffbot_sim.control import ackermann_steering_controller as asc
@@ -67,6 +69,7 @@ class ControllerManager:
         self.last_update = None
         self.last_step_update = None
         self._step_running, self._step_controllers = None, []  # see _every_step
+        self.pending = []  # switches asked for while paused: (start, stop, strictness, PendingSwitch)
 
     def full_name(self, name):
         return join(self.ns, name)
@@ -108,6 +111,25 @@ class ControllerManager:
                 self.loaded[name].start(now)
                 self.running.append(self.loaded[name])
             raise
+
+    def switch_later(self, start, stop, strictness):
+        """A switch asked for while physics is paused: upstream's realtime loop performs a switch at its next
+        update and the service waits for it, so a spawner's switch waits for the first step after the unpause
+        (a trajectory controller then starts from the pose ``spawn_model -J`` set while paused, not from the pose
+        before it). Returns what the service waits on."""
+        waiter = PendingSwitch()
+        self.pending.append((start, stop, strictness, waiter))
+        return waiter
+
+    def run_pending(self, now):
+        """The switches that waited for physics to run, performed before this step (the first after unpause)."""
+        pending, self.pending = self.pending, []
+        for start, stop, strictness, waiter in pending:
+            try:
+                self.switch(start, stop, strictness)
+            except (switching.SwitchError, ConfigError, ModelError) as err:
+                waiter.error = err
+            waiter.done.set()
 
     def _stop(self, name, now):
         controller = self.loaded[name]
@@ -233,6 +255,15 @@ class ControllerManager:
         return out
 
 
+class PendingSwitch:
+    """A switch the loop performs later (``ControllerManager.switch_later``): ``done`` is set when it has run,
+    ``error`` holds why it failed (None: it succeeded)."""
+
+    def __init__(self):
+        self.done = threading.Event()
+        self.error = None
+
+
 class ControllerManagerServices:
     """controller_manager's services in the plugin's namespace; each call runs on the simulator's loop."""
 
@@ -270,9 +301,16 @@ class ControllerManagerServices:
         return self.srv.UnloadControllerResponse(self._on_loop(lambda: self.manager.unload(req.name), "unload"))
 
     def _switch(self, req):
-        ok = self._on_loop(lambda: self.manager.switch(list(req.start_controllers), list(req.stop_controllers),
-                                                       req.strictness), "switch")
-        return self.srv.SwitchControllerResponse(ok)
+        args = (list(req.start_controllers), list(req.stop_controllers), req.strictness)
+        if not self.ctx.sim.paused:
+            return self.srv.SwitchControllerResponse(self._on_loop(lambda: self.manager.switch(*args), "switch"))
+        waiter = self.ctx.sim.call(lambda: self.manager.switch_later(*args))
+        while not waiter.done.wait(0.1):  # upstream's service polls until its realtime loop has switched
+            if rospy.is_shutdown():
+                return self.srv.SwitchControllerResponse(False)
+        if waiter.error is not None:
+            rospy.logerr(f"controller_manager {self.manager.ns}: switch: {waiter.error}")
+        return self.srv.SwitchControllerResponse(waiter.error is None)
 
     def _list(self, _req):
         from controller_manager_msgs.msg import ControllerState, HardwareInterfaceResources
