@@ -365,6 +365,7 @@ def main():
     add_package_path(MULTI_FIXTURES)
     add_package_path(CAR_FIXTURES)
     add_package_path(os.path.join(ROOT, "tests", "data", "arm_way"))  # fixed arms of published shapes: arm_way_*
+    add_package_path(os.path.join(ROOT, "tests", "data", "franka_way"))  # franka_gazebo's shape: franka_way_*
     total_p = total_f = total_s = 0
     failures = []
     if args.only is None:

@@ -145,6 +145,7 @@ class OtherTransmission:
     joints: List[str]
     interfaces: List[str]  # each joint's first <hardwareInterface>, as written ("" when it has none)
     why: str  # why DefaultRobotHWSim skips it
+    roles: List[str] = field(default_factory=list)  # each joint's <role> (franka_hw's root and tip), "" if none
 
     @property
     def warning(self):
@@ -367,7 +368,8 @@ def _transmission(el, index, model):
         names = [_required(j, "name", source, f"{path}/joint") for j in joint_els]
         return OtherTransmission(tname or f"transmission_{index}", ttype, names,
                                  [(j.findtext("hardwareInterface") or "").strip() for j in joint_els],
-                                 f"it names {len(names)} joints; DefaultRobotHWSim simulates one per transmission")
+                                 f"it names {len(names)} joints; DefaultRobotHWSim simulates one per transmission",
+                                 [(j.findtext("role") or "").strip() for j in joint_els])
     jname = _required(joint_els[0], "name", source, f"{path}/joint")
     jpath = f"{path}/joint[@name='{jname}']"
     actuator = el.find("actuator")

@@ -184,6 +184,32 @@ class Robot:
             return [float(matrix[offset + movable.index(i), offset + movable.index(i)]) for i in indices]
         return [1.0 / float(inverse[offset + movable.index(i), offset + movable.index(i)]) for i in indices]
 
+    def gravity_torques(self, indices, load=None):
+        """Torque [N·m or N] on each joint of ``indices`` that holds the body still against the world's gravity
+        at its current configuration: inverse dynamics at zero velocity and acceleration (every link beyond the
+        joint as PyBullet has it, lumped links included; a base counts as held). ``load``: (URDF link, (x, y, z)
+        in its frame [m], mass [kg]), a point mass the body does not have (a payload) whose weight is added."""
+        movable = sorted(self.joint_index.values())
+        c = self.client
+        positions = [s[0] for s in pybullet.getJointStates(self.body, movable, physicsClientId=c)]
+        zero = [0.0] * len(movable)
+        torques = pybullet.calculateInverseDynamics(self.body, positions, zero, zero, physicsClientId=c)
+        out = [float(torques[movable.index(i)]) for i in indices]
+        link, point, mass = load or (None, None, 0.0)
+        if mass:
+            carrier, xyz, quat = self.frames[link] if self.frames else (link, (0, 0, 0), (0, 0, 0, 1))
+            index = self._link_index[carrier]
+            inertial = pybullet.getDynamicsInfo(self.body, index, physicsClientId=c)[3:5]
+            at = pybullet.multiplyTransforms(xyz, quat, point, (0, 0, 0, 1))[0]  # in the carrier's link frame
+            local = pybullet.multiplyTransforms(*pybullet.invertTransform(*inertial), at, (0, 0, 0, 1))[0]
+            linear, _ = pybullet.calculateJacobian(self.body, index, local, positions, zero, zero, physicsClientId=c)
+            linear = np.array(linear)
+            offset = linear.shape[1] - len(movable)
+            weight = np.array([0.0, 0.0, mass * self.gravity])  # the force gravity puts on the load [N]
+            holding = -linear.T @ weight  # the joint torques that hold that force
+            out = [t + float(holding[offset + movable.index(i)]) for t, i in zip(out, indices)]
+        return out
+
     def joint_limits(self, index):
         """(lower, upper) [rad or m] PyBullet enforces on joint ``index`` (upper < lower: none)."""
         info = pybullet.getJointInfo(self.body, index, physicsClientId=self.client)

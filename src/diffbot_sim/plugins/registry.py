@@ -118,7 +118,9 @@ def build(ctx, found, params):
     rest = [t for t in ctx.model.transmissions if t.joint not in owned]
     if rest:
         plugins.append(JointMotors(ctx, rest))
-    mimics = mimic_joint.urdf_mimics(ctx, {p.cfg.mimic_joint for p in plugins if isinstance(p, mimic_joint.MimicJoint)})
+    # a <mimic> joint a plugin drives (a mimic plugin, or a controller through its transmission) is not followed
+    mimics = mimic_joint.urdf_mimics(ctx, owned | {t.joint for t in rest}
+                                     | {p.cfg.mimic_joint for p in plugins if isinstance(p, mimic_joint.MimicJoint)})
     if mimics is not None:
         plugins.append(mimics)
     if ctx.cfg.publish_ground_truth:

@@ -24,9 +24,10 @@ def test_franka_transmissions_are_kept_apart_and_the_rest_loads():
     state, kinematics, wrist = model.other_transmissions
     assert state == OtherTransmission("arm_franka_state", "franka_hw/FrankaStateInterface",
                                       ["joint_1", "joint_2", "joint_3"], ["franka_hw/FrankaStateInterface"] * 3,
-                                      "it names 3 joints; DefaultRobotHWSim simulates one per transmission")
-    assert (kinematics.joints, kinematics.interfaces) == (["joint_1", "joint_3"],
-                                                          ["franka_hw/FrankaModelInterface"] * 2)
+                                      "it names 3 joints; DefaultRobotHWSim simulates one per transmission",
+                                      ["", "", ""])
+    assert (kinematics.joints, kinematics.interfaces, kinematics.roles) == (
+        ["joint_1", "joint_3"], ["franka_hw/FrankaModelInterface"] * 2, ["root", "tip"])  # FrankaHWSim's chain
     assert wrist.joints == ["wrist_joint"] and wrist.interfaces == ["hardware_interface/PosVelJointInterface"]
     assert wrist.warning == ("transmission 'wrist_trans' (transmission_interface/SimpleTransmission) skipped by "
                              "DefaultRobotHWSim: its hardware interface 'hardware_interface/PosVelJointInterface' "

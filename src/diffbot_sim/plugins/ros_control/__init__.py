@@ -6,8 +6,8 @@ controllers (:mod:`.forward_command`), ``*/JointTrajectoryController`` (:mod:`.j
 ``*/GripperActionController`` (:mod:`.gripper_action`).
 
 Plugin tags: ``robotNamespace`` (default: the spawner's ``/``; a ``~robots`` robot's own namespace replaces
-it), ``robotSimType`` (DefaultRobotHWSim, and SteerBotHardwareGazebo in :mod:`.steer_bot_hardware`; another is
-one warning and the default), ``controlPeriod`` (s; see
+it), ``robotSimType`` (DefaultRobotHWSim, SteerBotHardwareGazebo in :mod:`.steer_bot_hardware`, FrankaHWSim in
+:mod:`.franka_hardware`; another is one warning and the default), ``controlPeriod`` (s; see
 :mod:`.manager` for the default), ``eStopTopic`` (std_msgs/Bool), ``robotParam`` and ``legacyModeNS`` (accepted).
 """
 import math
@@ -16,6 +16,7 @@ from std_msgs.msg import Bool
 
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.plugins.base import Plugin, join
+from diffbot_sim.plugins.ros_control.franka_hardware import FrankaHWSim
 from diffbot_sim.plugins.ros_control.hardware import RobotHWSim
 from diffbot_sim.plugins.ros_control.manager import KNOWN_TYPES, ControllerManager, ControllerManagerServices
 from diffbot_sim.plugins.ros_control.steer_bot_hardware import SteerBotHWSim
@@ -23,7 +24,8 @@ from diffbot_sim.values import tag_number
 
 DEFAULT_SIM_TYPE = "gazebo_ros_control/DefaultRobotHWSim"
 #: robotSimType -> the hardware simulated for it (built as ``cls(ctx, ns, warnings)``); others: the default
-HW_SIMS = {DEFAULT_SIM_TYPE: RobotHWSim, "steer_bot_hardware_gazebo/SteerBotHardwareGazebo": SteerBotHWSim}
+HW_SIMS = {DEFAULT_SIM_TYPE: RobotHWSim, "steer_bot_hardware_gazebo/SteerBotHardwareGazebo": SteerBotHWSim,
+           "franka_gazebo/FrankaHWSim": FrankaHWSim}
 
 
 class RosControl(Plugin):

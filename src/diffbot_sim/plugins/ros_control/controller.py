@@ -59,7 +59,8 @@ class Controller:
         """Upstream's init: every joint must be in the hardware under this controller's interface."""
         self.ctx.model.joint(joint, self.name)
         have = self.hw.interface(joint)
-        if have != interface:
+        offered = getattr(self.hw, "interfaces", None)  # a hardware whose joints offer several (FrankaHWSim)
+        if interface not in (offered(joint) if offered is not None else [have]):
             found = f"it has {have}" if have else "it has no transmission"
             raise ModelError(f"controller {self.name} needs joint '{joint}' with a {interface} transmission "
                              f"({found})", self.ctx.model.source)

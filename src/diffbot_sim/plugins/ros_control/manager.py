@@ -28,6 +28,8 @@ from diffbot_sim.plugins.ros_control.ackermann_steering import AckermannSteering
 from diffbot_sim.plugins.ros_control.diff_drive import DiffDriveController
 from diffbot_sim.plugins.ros_control.forward_command import ForwardCommandController
 from diffbot_sim.plugins.ros_control.four_wheel_steering import FourWheelSteeringController
+from diffbot_sim.plugins.ros_control.franka_gripper import FrankaGripperSim
+from diffbot_sim.plugins.ros_control.franka_state import FrankaStateController
 from diffbot_sim.plugins.ros_control.gripper_action import GripperActionController
 from diffbot_sim.plugins.ros_control.joint_state import JointStateController
 from diffbot_sim.plugins.ros_control.joint_trajectory import JointTrajectoryController
@@ -50,6 +52,8 @@ def _factories():
         table[kind] = lambda ctx, hw, name, params, ns: JointTrajectoryController(ctx, hw, name, params)
     for kind in (gac.POSITION_TYPE, gac.EFFORT_TYPE):
         table[kind] = lambda ctx, hw, name, params, ns: GripperActionController(ctx, hw, name, params)
+    for cls in (FrankaStateController, FrankaGripperSim):  # franka_ros's, on robotSimType franka_gazebo/FrankaHWSim
+        table[cls.type] = lambda ctx, hw, name, params, ns, cls=cls: cls(ctx, hw, name, params)
     return table
 
 
@@ -70,6 +74,9 @@ class ControllerManager:
         self.last_step_update = None
         self._step_running, self._step_controllers = None, []  # see _every_step
         self.pending = []  # switches asked for while paused: (start, stop, strictness, PendingSwitch)
+        attach = getattr(hw, "attach_manager", None)  # a robotSimType that acts on the controllers (FrankaHWSim)
+        if attach is not None:
+            attach(self)
 
     def full_name(self, name):
         return join(self.ns, name)
@@ -80,6 +87,7 @@ class ControllerManager:
         params = get_param(self.full_name(name), None)
         switching.check_load(name, self.loaded, params, KNOWN_TYPES)
         told = len(self.ctx.warnings)
+        self._hw_loading(name)
         controller = FACTORIES[params["type"]](self.ctx, self.hw, self.full_name(name), params,
                                                self.ns.rstrip("/") or "/")
         for text in self.ctx.warnings[told:]:  # the start-up report is long gone: say it now
@@ -93,10 +101,12 @@ class ControllerManager:
         claims = {n: c.joints() for n, c in self.loaded.items()}
         running = [n for n, c in self.loaded.items() if c in self.running]
         to_stop, to_start = switching.plan_switch(self.loaded, running, claims, start, stop, strictness)
+        self._hw_switch("prepare_switch", to_start)
         now = self.ctx.sim.sim_time
         for name in to_stop:
             self._stop(name, now)
         self.hw.read()
+        self._hw_switch("do_switch", to_start, to_stop)
         started = []
         try:
             for name in to_start:
@@ -107,6 +117,7 @@ class ControllerManager:
             for name in reversed(started):
                 self._stop(name, now)
             self.hw.read()
+            self._hw_switch("do_switch", to_stop, started)
             for name in to_stop:
                 self.loaded[name].start(now)
                 self.running.append(self.loaded[name])
@@ -130,6 +141,27 @@ class ControllerManager:
             except (switching.SwitchError, ConfigError, ModelError) as err:
                 waiter.error = err
             waiter.done.set()
+
+    def _hw_loading(self, name):
+        """Tell a hardware that keeps per-controller state (FrankaHWSim: which joints a controller hands to PyBullet's
+        motors) which controller the next calls come from."""
+        loading = getattr(self.hw, "loading", None)
+        if loading is not None:
+            loading(name)
+
+    def _hw_switch(self, hook, start, stop=()):
+        """RobotHW's prepareSwitch (``prepare_switch``: may refuse with SwitchError) and doSwitch (``do_switch``) for a
+        hardware that has them, with each controller's claims: {name: [(interface, [joints])]}."""
+        method = getattr(self.hw, hook, None)
+        if method is None:
+            return
+        def claims(names):
+            return {n: [(self.loaded[n].interface, sorted(self.loaded[n].joints()))] for n in names
+                    if self.loaded[n].interface}
+        if hook == "prepare_switch":
+            method(claims(start))
+        else:
+            method(claims(start), claims(stop))
 
     def _stop(self, name, now):
         controller = self.loaded[name]
@@ -158,15 +190,18 @@ class ControllerManager:
                 self.ctx.warnings.append(f"{full}: controller type {kind} is not simulated")
                 continue
             name = full[len(prefix):] if full.startswith(prefix) else full
+            self._hw_loading(name)
             controller = FACTORIES[kind](self.ctx, self.hw, full, params, self.ns.rstrip("/") or "/")
             self.loaded[name] = controller
             names.append(name)
         claims = {n: c.joints() for n, c in self.loaded.items()}
         try:
             switching.plan_switch(self.loaded, [], claims, names, [], switching.STRICT)
+            self._hw_switch("prepare_switch", names)
         except switching.SwitchError as err:
             raise ModelError(str(err), self.ctx.model.source) from None
         self.hw.read()
+        self._hw_switch("do_switch", names)
         for name in names:
             self.running.append(self.loaded[name])
 
