@@ -11,11 +11,11 @@ from gazebo_msgs.srv import GetLinkState
 from sensor_msgs.msg import JointState
 from simtest import action_done, wait_for
 from std_srvs.srv import Empty
-from stillness import held_still
 from traittest import sim_now
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from diffbot_sim.check.arm_check import pose_errors
+from diffbot_sim.check.stillness import held_still
 from diffbot_sim.description.urdf_model import parse_urdf
 
 

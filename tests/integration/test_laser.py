@@ -19,7 +19,8 @@ from laser_geometry import LaserProjection
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan, Range
 from simtest import wait_for
-from stillness import pose_still
+
+from diffbot_sim.check.stillness import pose_still
 
 SIM = "/bullet_sim"
 LASER_IN_FOOTPRINT = (0.05, 0.0, 0.113)  # base_footprint -> base_link 0.033 up, base_link -> laser (0.05, 0, 0.08)

@@ -18,8 +18,8 @@ from geometry_msgs.msg import Twist, Vector3Stamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import Imu, NavSatFix
 from simtest import wait_for
-from stillness import pose_still
 
+from diffbot_sim.check.stillness import pose_still
 from diffbot_sim.plugins.gps import radii
 from diffbot_sim.transforms import yaw_from_quaternion
 

@@ -17,7 +17,8 @@ import rostest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from simtest import sim_now, wait_for
-from stillness import held_still
+
+from diffbot_sim.check.stillness import held_still
 
 SIM = "/bullet_sim"
 SPEED, SECONDS, TOLERANCE = 0.3, 7.0, 0.02

@@ -3,19 +3,23 @@ commands it, as a user's client would (a FollowJointTrajectory goal, a GripperCo
 command topic), and the body judged after each move with the physics paused: every link Gazebo keeps
 (/gazebo/get_link_state) against where joint_states + the URDF put it. What to move and how it is judged is
 :mod:`diffbot_sim.check.arm_report` (pure)."""
+import collections
 import threading
 import time
 
 import rospy
 
-from diffbot_sim.check import arm_report
+from diffbot_sim.check import arm_report, stillness
 from diffbot_sim.check.arm_check import pose_errors
 
 SERVER_TIMEOUT = 20.0  # s (wall) for an action server or a command subscriber
 MOVE_TIME = 1.0  # s (sim): a trajectory goal's one point
 RESULT_TIMEOUT = 15.0  # s (sim) for a goal's result
 SETTLE_TIMEOUT = 5.0  # s (sim) for the joints to come to rest after a move
-AT_REST = 0.02  # rad/s (m/s): the moved joints' joint_states velocities below this count as at rest
+#: The moved joints are at rest once their joint_states positions held within SETTLE_BAND (rad or m) over
+#: SETTLE_WINDOW s of the messages' stamps (check.stillness): one message with low velocities is also an
+#: oscillation's turnaround.
+SETTLE_BAND, SETTLE_WINDOW = 1e-3, 0.3
 
 
 def wait_for_goal(client, timeout):
@@ -46,13 +50,20 @@ class _JointStates:
 
         self.lock = threading.Lock()
         self.positions, self.velocities, self.count = {}, {}, 0
+        self.history = collections.deque(maxlen=2000)  # (stamp [s, sim], {joint: position}) as they came
         self.sub = rospy.Subscriber(topic, JointState, self._keep, queue_size=20)
 
     def _keep(self, msg):
         with self.lock:
             self.positions.update(zip(msg.name, msg.position))
             self.velocities.update(zip(msg.name, msg.velocity))
+            self.history.append((msg.header.stamp.to_sec(), dict(self.positions)))
             self.count += 1
+
+    def samples(self, joints, since):
+        """[(stamp, [position of each joint])] of the messages stamped at or after sim time ``since``."""
+        with self.lock:
+            return [(stamp, [p.get(j, 0.0) for j in joints]) for stamp, p in self.history if stamp >= since]
 
     def get(self):
         with self.lock:
@@ -177,14 +188,14 @@ class _Sender:
 
 
 def _settle(states, joints):
-    """Wait (sim time) until the joints' velocities are at rest, then a little longer."""
-    deadline = rospy.get_time() + SETTLE_TIMEOUT
-    while rospy.get_time() < deadline:
-        velocities = states.get()[1]
-        if all(abs(velocities.get(j, 0.0)) < AT_REST for j in joints):
-            break
+    """Wait (sim time, at most SETTLE_TIMEOUT) until the moved joints held still, judged by the stamps of the
+    joint_states messages that came after the move (check.stillness.held_still)."""
+    since = rospy.get_time()
+    deadline = since + SETTLE_TIMEOUT
+    while rospy.get_time() < deadline and not rospy.is_shutdown():
+        if stillness.held_still(states.samples(joints, since), SETTLE_BAND, SETTLE_WINDOW)[0]:
+            return
         rospy.sleep(0.05)
-    rospy.sleep(0.3)
 
 
 def check_arm(report, wait):
@@ -197,7 +208,7 @@ def check_arm(report, wait):
     ns = report.control_ns
     states = _JointStates(_name(ns, "joint_states"))
     wait(lambda: states.get()[2] > 0, SERVER_TIMEOUT, f"{_name(ns, 'joint_states')}")
-    rospy.sleep(0.5)  # the controllers have started and hold the joints
+    _settle(states, [j.name for j in report.joints])  # the controllers have started and hold the joints
     positions = states.get()[0]
     moves, skipped = arm_report.plan_moves(report.joints, positions,
                                            arm_report.controller_joints(report.controllers, ns))

@@ -4,9 +4,11 @@ A "before" or "after" sample of a body must be taken once it holds still, and "s
 message with a low velocity is also the turnaround of an oscillation, and a reading a fixed time after a
 command is a guess about how long settling takes on this machine. ``held_still`` looks at the samples' own
 stamps (sim time, as the simulator stamped them), so a test node that reads them late judges the same window.
-Pure: no ROS; the suites feed it what their callbacks kept.
+Pure: no ROS; the suites and robot_check feed it what their callbacks kept.
 """
 import math
+
+from diffbot_sim.transforms import quaternion_rpy
 
 
 def held_still(samples, band, window):
@@ -34,9 +36,7 @@ def pose_values(pose, heading=0.0):
     (the last sample's: no jump where it wraps at +-pi; angles rather than quaternion components, which a
     publisher may flip in sign)."""
     p, q = pose.position, pose.orientation
-    roll = math.atan2(2.0 * (q.w * q.x + q.y * q.z), 1.0 - 2.0 * (q.x * q.x + q.y * q.y))
-    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (q.w * q.y - q.z * q.x))))
-    yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    roll, pitch, yaw = quaternion_rpy((q.x, q.y, q.z, q.w))
     return [p.x, p.y, p.z, roll, pitch, math.remainder(yaw - heading, 2.0 * math.pi)]
 
 
