@@ -208,7 +208,8 @@ class JointTrajectoryControllerCore:
             self._active_goal = None
             self._done.clear()
         commands = self._commands(desired, error)
-        return JtcUpdate(commands, desired, actual, error, tuple(events), self._state_due(), self._active_goal)
+        return _tuple_new(JtcUpdate, (commands, desired, actual, error, tuple(events), self._state_due(),
+                                      self._active_goal))
 
     def _measure(self, positions, velocities):
         """Keep the joints' measured positions and velocities (one per controller joint, in its order)."""
