@@ -20,6 +20,8 @@ Items (``--only a,b``, or ``make bench ITEMS=a,b``):
   batch        `batch`'s overhead per run; the drive example at --jobs 1 and 2
   arm          fast-mode RTF of a base with a 6-joint arm on a trajectory, against bare PyBullet; command ->
                first motion
+  fixed_arm    fast-mode RTF of 6-joint effort arms bolted to the world at a 1 ms step (UR5-like; and the arm
+               cell with its gripper, item fixed_arm_cell), against bare PyBullet with a PD, by RTF and by CPU
   lockstep     a Gazebo-style step-and-wait learning environment against fast mode
   gym          the Gymnasium environment: env steps per CPU second, against bare PyBullet
   scale        namespaced seed robots kept at real time (scale_rsp: with a robot_state_publisher each)
