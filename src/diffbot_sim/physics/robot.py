@@ -196,18 +196,17 @@ class Robot:
         torques = pybullet.calculateInverseDynamics(self.body, positions, zero, zero, physicsClientId=c)
         out = [float(torques[movable.index(i)]) for i in indices]
         link, point, mass = load or (None, None, 0.0)
-        if mass:
-            carrier, xyz, quat = self.frames[link] if self.frames else (link, (0, 0, 0), (0, 0, 0, 1))
-            index = self._link_index[carrier]
-            inertial = pybullet.getDynamicsInfo(self.body, index, physicsClientId=c)[3:5]
-            at = pybullet.multiplyTransforms(xyz, quat, point, (0, 0, 0, 1))[0]  # in the carrier's link frame
-            local = pybullet.multiplyTransforms(*pybullet.invertTransform(*inertial), at, (0, 0, 0, 1))[0]
-            linear, _ = pybullet.calculateJacobian(self.body, index, local, positions, zero, zero, physicsClientId=c)
-            linear = np.array(linear)
-            offset = linear.shape[1] - len(movable)
-            weight = np.array([0.0, 0.0, mass * self.gravity])  # the force gravity puts on the load [N]
-            holding = -linear.T @ weight  # the joint torques that hold that force
-            out = [t + float(holding[offset + movable.index(i)]) for t, i in zip(out, indices)]
+        if mass:  # the weight F at p: each joint holds -(r x F) . axis (a slide: -F . axis), r from the joint to p
+            at = pybullet.multiplyTransforms(*self.link_pose(link), point, (0, 0, 0, 1))[0]
+            weight = (0.0, 0.0, mass * self.gravity)
+            for k, index in enumerate(indices):
+                info = pybullet.getJointInfo(self.body, index, physicsClientId=c)
+                origin, orientation = pybullet.getLinkState(self.body, index, physicsClientId=c)[4:6]
+                axis = pybullet.multiplyTransforms((0, 0, 0), orientation, info[13], (0, 0, 0, 1))[0]
+                if info[2] == pybullet.JOINT_PRISMATIC:
+                    out[k] -= float(np.dot(weight, axis))
+                else:
+                    out[k] -= float(np.dot(np.cross(np.subtract(at, origin), weight), axis))
         return out
 
     def joint_limits(self, index):
