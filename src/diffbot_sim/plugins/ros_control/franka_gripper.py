@@ -142,7 +142,7 @@ class FrankaGripperSim(Controller):
     def start(self, now):
         super().start(now)
         self.core.starting()
-        self.next = now
+        self.next = now + 1.0 / PUBLISH_RATE  # franka_hw's TriggerRate: one period after the start
 
     def stop(self, now):
         super().stop(now)

@@ -63,8 +63,9 @@ class FrankaStateController(Controller):
         return [self.state_pub, self.joint_pub, self.desired_pub, self.wrench_pub]
 
     def start(self, now):
+        """franka_hw's TriggerRate: the first publication one period after the start."""
         super().start(now)
-        self.next = now
+        self.next = now + self.period
 
     def update(self, now, period, stamp, transforms):
         if now + 1e-9 < self.next:
