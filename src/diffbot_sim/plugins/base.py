@@ -203,8 +203,8 @@ class Plugin:
         return self.next
 
     def before_step(self, now):
-        """Apply new commands and run control that is due (called before each physics step, and at once
-        when a callback wakes the loop in real time)."""
+        """Apply new commands and run control that is due (called once before each run of physics steps, at the
+        sim time of its first step; ``next_control`` says when it must be called again)."""
 
     def after_step(self, now, stamp, transforms):
         """Publish what is due; TF transforms go into ``transforms`` (one TFMessage per step)."""

@@ -324,13 +324,11 @@ class Simulator:
                     step_at = self._step_reaching(due)
                     wait = (max(step_at, self.sim_time + dt) - target) / cfg.real_time_factor
                     if self.wake.wait(min(max(wait, 0.0), 0.1)):
+                        # A command woke us: it is taken now, and applied by the plugins' before_step at the
+                        # next step, once (a plugin's step work is not repeated: PyBullet adds up torques set
+                        # twice before one step, and a PID would step twice).
                         self.wake.clear()
-                        # A command woke us: set the motor targets now rather than at the next step
-                        # (up to one step later). Same sim time, so the physics sees no difference.
                         self._handle_requests()
-                        if not self.paused:
-                            for runtime in self.robots:
-                                runtime.before_step(self.sim_time)
                     continue
             self._step_once(limit)
 
