@@ -6,7 +6,6 @@ parameters. Every bad value raises ``ConfigError`` naming the parameter (``~time
 plugin element it stands in; a model that contradicts itself raises ``ModelError``.
 """
 from dataclasses import asdict, dataclass, field, fields
-from typing import List, Optional
 
 from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.values import check_bool, check_number, check_string, tag_number
@@ -39,7 +38,7 @@ class SimConfig:
     fast_batch: float = 0.005  # s (wall); fast mode sends messages in bursts this often; 0: one write each
     wait_for_nodes: bool = True  # fast mode: after each sensor message, hold sim time until its subscribers answered
     wait_for_nodes_timeout: float = 5.0  # s (wall); a node that holds the simulator longer is not waited for
-    wait_for_nodes_ignore: List[str] = field(default_factory=lambda: ["/rviz*", "/rqt*"])  # caller-id patterns
+    wait_for_nodes_ignore: list[str] = field(default_factory=lambda: ["/rviz*", "/rqt*"])  # caller-id patterns
     send_timeout: float = 0.5  # s (wall); a subscriber that takes no data for this long is disconnected
     clock_rate: float = 100.0  # Hz of /clock, in sim time
     clock_max_wall_rate: float = 500.0  # Hz (wall): /clock at most this often; a faster run coalesces ticks; 0: no cap
@@ -69,10 +68,10 @@ class SimConfig:
 class GazeboDiffDriveConfig:
     """The diff drive, as gazebo_ros_diff_drive defines it (ROS 1 defaults), after tags and parameters."""
 
-    left_joints: List[str] = field(default_factory=lambda: ["left_joint"])
-    right_joints: List[str] = field(default_factory=lambda: ["right_joint"])
-    wheel_separation: Optional[float] = None  # m; None: from the URDF wheel joint origins
-    wheel_diameter: Optional[float] = None  # m; None: from the URDF wheel collision (cylinder/sphere)
+    left_joints: list[str] = field(default_factory=lambda: ["left_joint"])
+    right_joints: list[str] = field(default_factory=lambda: ["right_joint"])
+    wheel_separation: float | None = None  # m; None: from the URDF wheel joint origins
+    wheel_diameter: float | None = None  # m; None: from the URDF wheel collision (cylinder/sphere)
     max_wheel_torque: float = 5.0  # N·m per wheel joint
     max_wheel_acceleration: float = 0.0  # m/s^2 at the wheel rim; 0: no limit
     update_rate: float = 100.0  # Hz, in sim time; 0: every physics step
@@ -84,7 +83,7 @@ class GazeboDiffDriveConfig:
     publish_odom: bool = True
     publish_odom_tf: bool = True
     publish_wheel_joint_state: bool = False
-    namespace: Optional[str] = None  # None: the node's namespace
+    namespace: str | None = None  # None: the node's namespace
     covariance_x: float = 1e-5  # m^2, pose and twist diagonals
     covariance_y: float = 1e-5
     covariance_yaw: float = 1e-3  # rad^2
@@ -146,10 +145,10 @@ ROS2_DRIVE_DEFAULTS = {"publish_odom": False, "publish_odom_tf": False}
 
 @dataclass
 class JointStateConfig:
-    joints: List[str] = field(default_factory=list)
+    joints: list[str] = field(default_factory=list)
     update_rate: float = 100.0  # Hz, in sim time
     topic: str = "joint_states"
-    namespace: Optional[str] = None
+    namespace: str | None = None
 
 
 @dataclass
@@ -168,7 +167,7 @@ class RobotSpec:
     y: float = 0.0
     z: float = 0.0
     yaw: float = 0.0  # rad
-    tf_prefix: Optional[str] = None  # None: the name; "" : no prefix
+    tf_prefix: str | None = None  # None: the name; "" : no prefix
 
 
 # ---------------------------------------------------------------------------------------------- builders
@@ -180,7 +179,10 @@ def sim_config(params):
     for key, value in params.items():
         if key in known:
             setattr(cfg, key, value)
-    name = lambda k: f"~{k}"  # noqa: E731
+
+    def name(k):
+        return f"~{k}"
+
     cfg.model = check_string(name("model"), cfg.model, allow_empty=True)
     cfg.model_args = check_string(name("model_args"), cfg.model_args, allow_empty=True)
     if not params.get("world") and params.get("world_name"):

@@ -11,7 +11,8 @@ Pure: no ROS, no clock but the one passed in (``time.monotonic`` by default), so
 sleeping.
 """
 import time
-from typing import Callable, Optional, TypeVar
+from collections.abc import Callable
+from typing import TypeVar
 
 T = TypeVar("T")
 
@@ -22,7 +23,7 @@ POLL = 0.01
 
 def wait_for(predicate: Callable[[], T], timeout: float, what: str, poll: float = POLL, *,
              error: Callable[[str], BaseException] = TimeoutError,
-             give_up: Optional[Callable[[], object]] = None,
+             give_up: Callable[[], object] | None = None,
              clock: Callable[[], float] = time.monotonic,
              sleep: Callable[[float], object] = time.sleep) -> T:
     """Poll ``predicate`` every ``poll`` s until it returns a true value, and return that value.

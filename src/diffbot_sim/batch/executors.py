@@ -114,8 +114,8 @@ def _on_every_node(ray, marker, work_prefix=None):
     from ray.util.scheduling_strategies import NodeAffinitySchedulingStrategy
 
     cleanup = ray.remote(num_cpus=0, max_retries=0)(_cleanup_task)
-    refs = [cleanup.options(scheduling_strategy=NodeAffinitySchedulingStrategy(n, soft=False)).remote(marker, work_prefix)
-            for n in _alive_nodes(ray)]
+    refs = [cleanup.options(scheduling_strategy=NodeAffinitySchedulingStrategy(n, soft=False))
+            .remote(marker, work_prefix) for n in _alive_nodes(ray)]
     try:
         ray.get(refs, timeout=60)
     except Exception:  # a node lost meanwhile: nothing of ours left running there

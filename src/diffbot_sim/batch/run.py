@@ -24,7 +24,6 @@ import threading
 import time
 import xml.etree.ElementTree as ET
 import xmlrpc.client
-from typing import Optional
 
 from diffbot_sim.batch.scenarios import Run
 
@@ -155,7 +154,7 @@ def read_sim_time(path):
         return 0.0
 
 
-def run_once(run: Run, out_dir, batch_id, node, stop: Optional[threading.Event] = None, attempt=1,
+def run_once(run: Run, out_dir, batch_id, node, stop: threading.Event | None = None, attempt=1,
              python=sys.executable):
     """Run ``run`` here, its folder under ``out_dir``; returns its record (a dict, results.jsonl's fields), or
     None when ``stop`` was set before it ended (the run is not recorded: a resumed batch runs it again)."""
@@ -220,7 +219,8 @@ def run_once(run: Run, out_dir, batch_id, node, stop: Optional[threading.Event] 
         return None
     sim = read_sim_time(clock_file)
     status, tests, failures, reason, figures, metrics = judge(os.path.join(run_dir, "results"), code, timed_out)
-    return make_record(run, status, node, run_dir, started, wall, sim, tests, failures, reason, figures, metrics, attempt)
+    return make_record(run, status, node, run_dir, started, wall, sim, tests, failures, reason, figures, metrics,
+                       attempt)
 
 
 def make_record(run, status, node, run_dir, started, wall, sim, tests, failures, reason, figures, metrics, attempt):

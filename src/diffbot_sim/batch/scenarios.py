@@ -15,8 +15,8 @@ the element, raised before anything runs.
 import itertools
 import os
 import string
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable, Dict, List, Optional
 
 import yaml
 
@@ -38,7 +38,7 @@ class Run:
     name: str
     test: str  # as written in the file
     test_path: str  # absolute path of the .test file
-    args: Dict[str, str] = field(default_factory=dict)
+    args: dict[str, str] = field(default_factory=dict)
     timeout: float = DEFAULT_TIMEOUT
     cpus: float = DEFAULT_CPUS
 
@@ -84,7 +84,7 @@ def _fields(template):
     return names
 
 
-def expand(data, source, find_package: Callable[[str], str], base_dir: Optional[str] = None) -> List[Run]:
+def expand(data, source, find_package: Callable[[str], str], base_dir: str | None = None) -> list[Run]:
     """Every run of a parsed scenario file (``data``, from YAML; ``source`` names it in errors)."""
     base_dir = base_dir if base_dir is not None else os.path.dirname(os.path.abspath(source))
 
@@ -165,7 +165,7 @@ def expand(data, source, find_package: Callable[[str], str], base_dir: Optional[
     return runs
 
 
-def load(path, find_package) -> List[Run]:
+def load(path, find_package) -> list[Run]:
     """Read ``path`` and expand it (:func:`expand`); ScenarioError on any mistake."""
     try:
         with open(path) as f:

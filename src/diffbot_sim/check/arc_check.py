@@ -9,7 +9,7 @@ heading: its velocity has no sideways part. Both are measured on ground truth: t
 and the body's heading. Samples are plain tuples; the rostest suites and ``robot_check`` share these rules.
 """
 import math
-from typing import List, NamedTuple
+from typing import NamedTuple
 
 from diffbot_sim.transforms import wrap_angle
 
@@ -67,8 +67,9 @@ def geometry_radius(wheelbase, steer):
 
 def front_wheel_radii(wheelbase, track, right, left):
     """The rear axle middle's turning radius [m] each steered front wheel alone implies, (by the right wheel, by
-    the left wheel; signed: negative turning right), for wheels at ``right``/``left`` [rad] ``track`` [m] apart: where its axis meets the rear
-    axle's line. A linkage that is not exactly Ackermann's makes them differ; the body turns between them."""
+    the left wheel; signed: negative turning right), for wheels at ``right``/``left`` [rad] ``track`` [m] apart:
+    where its axis meets the rear axle's line. A linkage that is not exactly Ackermann's makes them differ; the
+    body turns between them."""
     def by(angle, side):
         return math.inf if abs(math.tan(angle)) < 1e-12 else wheelbase / math.tan(angle) + side * track / 2
     return by(right, -1) if right else math.inf, by(left, 1) if left else math.inf
@@ -116,7 +117,7 @@ class Arc(NamedTuple):
     max_slip: float
     turned: float  # rad of heading over the samples
     passed: bool
-    failures: List[str]
+    failures: list[str]
 
 
 def arc(samples, wheelbase, steer, radius_tolerance=RADIUS_TOLERANCE, max_slip=MAX_SLIP, radius_range=None):

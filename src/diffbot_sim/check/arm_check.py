@@ -7,9 +7,9 @@ a joint without a position in ``positions``: at 0, or its URDF ``<mimic>`` of on
 robot_state_publisher does. :func:`pose_errors` compares those poses with measured ones.
 """
 import math
-from typing import Dict, NamedTuple
+from typing import NamedTuple
 
-from diffbot_sim.transforms import compose, inverse, qmul, qconj, rpy_quaternion
+from diffbot_sim.transforms import compose, inverse, qconj, qmul, rpy_quaternion
 
 IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
@@ -70,7 +70,7 @@ def pose_error(a, b):
     return PoseError(d, angle)
 
 
-def pose_errors(model, positions, measured) -> Dict[str, PoseError]:
+def pose_errors(model, positions, measured) -> dict[str, PoseError]:
     """For each link of ``measured`` ({link: world pose}, the physics' ground truth, with the root among
     them): the error of the pose joint_states + the URDF give it, both taken relative to the root."""
     fk = forward_kinematics(model, positions)

@@ -14,7 +14,6 @@ the controller that commands it, and the small moves that judge an arm by its bo
 """
 import math
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Tuple
 
 from diffbot_sim.control.joint_limits import JointLimitsInterfaceError, register_joint_limits
 from diffbot_sim.control.pid import pid_gains
@@ -156,9 +155,9 @@ class Move:
     controller: str
     controller_type: str
     how: str  # TRAJECTORY, GRIPPER or POSITION_TOPIC
-    joints: List[str]
-    targets: List[float]
-    moved: List[str]  # the joints this move judges (arm joints of the controller)
+    joints: list[str]
+    targets: list[float]
+    moved: list[str]  # the joints this move judges (arm joints of the controller)
 
 
 def send_kind(controller_type):
@@ -223,14 +222,14 @@ class MoveResult:
 
     move: Move
     phase: str  # "out" or "back"
-    reached: Dict[str, float]  # joint -> position after the move
-    wanted: Dict[str, float]
-    slides: Dict[str, bool]
+    reached: dict[str, float]  # joint -> position after the move
+    wanted: dict[str, float]
+    slides: dict[str, bool]
     worst_link: str = ""
     distance: float = 0.0  # m
     angle: float = 0.0  # rad
     answer: str = ""  # what the controller answered (goal status), "" for a topic
-    failures: List[str] = field(default_factory=list)
+    failures: list[str] = field(default_factory=list)
 
     @property
     def passed(self):
@@ -277,7 +276,7 @@ def format_moves(results, skipped):
     return lines
 
 
-def controller_joints(controllers, ns) -> Dict[str, List[str]]:
+def controller_joints(controllers, ns) -> dict[str, list[str]]:
     """{controller name relative to ``ns``: the joints it commands, in its order}."""
     prefix = "/" + ns.strip("/") if ns.strip("/") else ""
     out = {}
@@ -287,13 +286,13 @@ def controller_joints(controllers, ns) -> Dict[str, List[str]]:
     return out
 
 
-def mimic_pairs(plugins) -> List[Tuple[str, str]]:
+def mimic_pairs(plugins) -> list[tuple[str, str]]:
     """[(master, mimic joint)] of the mimic-joint plugins among ``plugins`` ([(filename, {tag: text})])."""
     return [(tags.get("joint", ""), tags.get("mimicJoint", "")) for filename, tags in plugins
             if filename in MIMIC_PLUGINS]
 
 
-def max_effort_for(info: Optional[JointInfo], params):
+def max_effort_for(info: JointInfo | None, params):
     """The GripperCommand max_effort robot_check sends: the controller's ``max_effort`` if set, else the
     joint's effort limit (an effort gripper with 0 does not move), else 10."""
     value = params.get("max_effort") if isinstance(params, dict) else None

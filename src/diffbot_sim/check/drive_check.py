@@ -7,16 +7,20 @@ judged on the physics ground truth: before driving it rests upright at the heigh
 flat ground (:func:`rest`), while driving it stays there (:func:`ride`), and it moves and turns as commanded
 (:func:`straight`, :func:`strafe`, :func:`turn`; the motions: :func:`runs`). The robot's own odometry is a
 second, separate claim, checked against the command too: a ros_control robot's odometry integrates its wheel
-encoders and reads a perfect drive while the body flies, sinks or slides. Motion poses are plain ``(x, y, yaw)`` tuples (m, m, rad) at the start and at the
-end of a motion; body samples are :class:`BodySample` tuples; nothing here knows ROS messages.
+encoders and reads a perfect drive while the body flies, sinks or slides. Motion poses are plain ``(x, y, yaw)``
+tuples (m, m, rad) at the start and at the end of a motion; body samples are :class:`BodySample` tuples; nothing
+here knows ROS messages.
 """
 import math
 import statistics
 from dataclasses import dataclass, field
-from typing import List, NamedTuple, Optional
+from typing import NamedTuple
 
-from diffbot_sim.transforms import roll_pitch_from_quaternion, yaw_from_quaternion
-from diffbot_sim.transforms import wrap_angle as wrap  # drive_check.wrap: callers' name for it
+from diffbot_sim.transforms import (
+    roll_pitch_from_quaternion,
+    wrap_angle as wrap,  # drive_check.wrap: callers' name for it
+    yaw_from_quaternion,
+)
 
 SPEED = 0.2  # m/s, the straight run's command
 TURN = 0.5  # rad/s, the turn in place's command
@@ -108,7 +112,7 @@ class Straight:
     truth_distance: float  # m
     odom_heading: float  # rad, absolute heading change
     truth_heading: float  # rad
-    failures: List[str] = field(default_factory=list)
+    failures: list[str] = field(default_factory=list)
 
     @property
     def passed(self):
@@ -123,7 +127,7 @@ class Turn:
     odom_yaw: float  # rad, signed
     truth_yaw: float  # rad, signed
     moved: float  # m the point the body turns about (the middle of its drive wheels) moved while turning
-    failures: List[str] = field(default_factory=list)
+    failures: list[str] = field(default_factory=list)
 
     @property
     def passed(self):
@@ -157,7 +161,7 @@ class Strafe:
     truth_forward: float
     odom_heading: float  # rad, absolute heading change
     truth_heading: float
-    failures: List[str] = field(default_factory=list)
+    failures: list[str] = field(default_factory=list)
 
     @property
     def passed(self):
@@ -244,12 +248,12 @@ class Rest:
     """The body before driving, judged on ground-truth samples over a span of rest; ``failures`` empty when
     it rests upright where its geometry says it should."""
 
-    expected: Optional[float]  # m, the root link's height when the robot stands on flat ground (None: unknown)
+    expected: float | None  # m, the root link's height when the robot stands on flat ground (None: unknown)
     height: float  # m, the median height of the root link over the samples
     tilt: float  # rad, the largest tilt
     spread: float  # m, highest minus lowest height (a bouncing or sinking body)
     speed: float  # m/s, how fast the origin moved over the span, on average
-    failures: List[str] = field(default_factory=list)
+    failures: list[str] = field(default_factory=list)
 
     @property
     def passed(self):
@@ -290,7 +294,7 @@ class Ride:
     low: float  # m, lowest height while driving
     high: float  # m, highest
     tilt: float  # rad, the largest tilt
-    failures: List[str] = field(default_factory=list)
+    failures: list[str] = field(default_factory=list)
 
     @property
     def passed(self):

@@ -15,7 +15,6 @@ numbers (origin, resolution, width, height, data: -1 unknown, 0 free, 100 occupi
 import math
 from collections import deque
 from dataclasses import dataclass, field
-from typing import List, Tuple
 
 import numpy as np
 
@@ -77,7 +76,8 @@ def _cylinder(radius, length, sides=48):
     faces = []
     for i in range(sides):
         j = (i + 1) % sides
-        faces += [(i, j, sides + j), (i, sides + j, sides + i), (2 * sides, j, i), (2 * sides + 1, sides + i, sides + j)]
+        faces += [(i, j, sides + j), (i, sides + j, sides + i), (2 * sides, j, i),
+                  (2 * sides + 1, sides + i, sides + j)]
     return v, np.array(faces)
 
 
@@ -224,7 +224,7 @@ class Obstacle:
     """One connected true solid on the map's grid, and how much of what the robot saw of it is mapped."""
 
     cells: int  # grid cells inside it
-    centre: Tuple[float, float]  # m, the mean of its cells
+    centre: tuple[float, float]  # m, the mean of its cells
     seen: int  # boundary cells with a free map cell next to them
     mapped: int  # of those, with an occupied map cell within NEAR
 
@@ -234,9 +234,9 @@ class MapReport:
     occupied: int  # occupied map cells
     near_fraction: float  # of them, within NEAR of a true surface
     median_error: float  # m, their median distance to the nearest true surface
-    obstacles: List[Obstacle] = field(default_factory=list)
+    obstacles: list[Obstacle] = field(default_factory=list)
     free_inside: int = 0  # free map cells deeper than DEEP inside a true solid
-    failures: List[str] = field(default_factory=list)
+    failures: list[str] = field(default_factory=list)
 
     @property
     def passed(self):

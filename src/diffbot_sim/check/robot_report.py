@@ -5,20 +5,21 @@ did: which plugin or controller drives it, where each number of its geometry cam
 parameter, or measured from the URDF as diff_drive_controller measures it), what is not simulated, and what
 ``bullet_sim`` will warn about. This module answers from the same pure units the simulator uses (description,
 model, plugins.tags, config, ddc, meshes, physics), without a ROS master; :func:`build_report` returns plain
-data and :func:`diffbot_sim.check.report_text.format_report` turns it into lines. Controller YAML files are passed in already loaded
-(``rosparam.load_file`` in the node), so nothing here needs ROS.
+data and :func:`diffbot_sim.check.report_text.format_report` turns it into lines. Controller YAML files are passed
+in already loaded (``rosparam.load_file`` in the node), so nothing here needs ROS.
 """
 import math
 import os
 from dataclasses import dataclass, field
-from typing import List, Optional, Tuple
 
 from diffbot_sim import config as cfgmod
 from diffbot_sim.check import arc_check, arm_report
 from diffbot_sim.check.drive_check import HOLONOMIC_PLUGINS
-from diffbot_sim.control import ackermann_steering_controller as asc
-from diffbot_sim.control import diff_drive_config as ddc
-from diffbot_sim.control import steer_bot_hardware as sbh
+from diffbot_sim.control import (
+    ackermann_steering_controller as asc,
+    diff_drive_config as ddc,
+    steer_bot_hardware as sbh,
+)
 from diffbot_sim.control.controller_lookup import find_controllers
 from diffbot_sim.control.four_wheel_steering_controller import joint_offset
 from diffbot_sim.description.gazebo_collisions import sensor_collision
@@ -49,19 +50,19 @@ class Drive:
 
     kind: str  # plugin filename or controller type
     where: str  # element path, or ``/controller from file.yaml``
-    left: List[str] = field(default_factory=list)
-    right: List[str] = field(default_factory=list)
-    separation: Optional[float] = None  # m, as used (multiplier applied)
+    left: list[str] = field(default_factory=list)
+    right: list[str] = field(default_factory=list)
+    separation: float | None = None  # m, as used (multiplier applied)
     separation_from: str = ""
-    radius: Optional[float] = None  # m, as used (multiplier applied)
+    radius: float | None = None  # m, as used (multiplier applied)
     radius_from: str = ""
     note: str = ""  # e.g. "holonomic: no wheels"
     #: car-like (ackermann_steering_controller): the bicycle model's wheelbase [m], the rear axle's middle in the
     #: root link's frame (x, y) and the turning radii its arc may have (None: L / tan δ exactly)
-    wheelbase: Optional[float] = None
-    steering: List[str] = field(default_factory=list)  # steering joints (a car's): neither wheels nor arm joints
-    rear_axle: Tuple[float, float] = (0.0, 0.0)
-    radius_range: Optional[Tuple[float, float]] = None
+    wheelbase: float | None = None
+    steering: list[str] = field(default_factory=list)  # steering joints (a car's): neither wheels nor arm joints
+    rear_axle: tuple[float, float] = (0.0, 0.0)
+    radius_range: tuple[float, float] | None = None
 
 
 @dataclass
@@ -81,19 +82,19 @@ class Report:
     name: str
     urdf_mass: float  # kg
     loaded_mass: float  # kg
-    drives: List[Drive] = field(default_factory=list)
-    items: List[Item] = field(default_factory=list)
-    warnings: List[str] = field(default_factory=list)
-    rest_height: Optional[float] = None  # m: the root link's height when the robot stands on flat ground
+    drives: list[Drive] = field(default_factory=list)
+    items: list[Item] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    rest_height: float | None = None  # m: the root link's height when the robot stands on flat ground
     #: m: the middle of the first drive's wheel centres in the root link's frame (x, y), which turns in place
-    wheel_centre: Tuple[float, float] = (0.0, 0.0)
-    footprint: Optional[Tuple[float, float]] = None  # m: those wheels' farthest |x|, |y| from that middle
+    wheel_centre: tuple[float, float] = (0.0, 0.0)
+    footprint: tuple[float, float] | None = None  # m: those wheels' farthest |x|, |y| from that middle
     #: every transmission joint: interface, limits, controller, role (check.arm_report.JointInfo)
-    joints: List[arm_report.JointInfo] = field(default_factory=list)
+    joints: list[arm_report.JointInfo] = field(default_factory=list)
     model: object = None  # the parsed URDF (description.urdf_model.RobotModel)
     control_ns: str = "/"  # gazebo_ros_control's robotNamespace
     controllers: dict = field(default_factory=dict)  # {controller namespace: parameters} found under it
-    contacts: List[str] = field(default_factory=list)  # one line per contact sensor: its collision, its topics
+    contacts: list[str] = field(default_factory=list)  # one line per contact sensor: its collision, its topics
 
     @property
     def arm_joints(self):

@@ -117,7 +117,7 @@ class Session:
         import rosgraph
         import rosparam
 
-        for attempt in range(3):  # a free port can be taken between the probe and roscore binding it
+        for _attempt in range(3):  # a free port can be taken between the probe and roscore binding it
             port = _free_port()
             os.environ["ROS_MASTER_URI"] = f"http://localhost:{port}"
             os.environ["ROS_LOG_DIR"] = self.tmp

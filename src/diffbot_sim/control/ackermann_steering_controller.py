@@ -19,13 +19,15 @@ reading the URDF belong to the caller (:mod:`diffbot_sim.plugins.ros_control.ack
 import math
 from collections import deque
 from dataclasses import dataclass, field
-from typing import NamedTuple, Optional, Tuple
+from typing import NamedTuple
 
-from diffbot_sim.control.diff_drive_config import AxisLimits
-from diffbot_sim.control.diff_drive_config import _axis_limits as axis_limits
-from diffbot_sim.control.diff_drive_config import _bool as check_bool
-from diffbot_sim.control.diff_drive_config import _covariance as covariance
-from diffbot_sim.control.diff_drive_config import _number as check_number
+from diffbot_sim.control.diff_drive_config import (
+    AxisLimits,
+    _axis_limits as axis_limits,
+    _bool as check_bool,
+    _covariance as covariance,
+    _number as check_number,
+)
 from diffbot_sim.control.odometry import integrate_exact
 from diffbot_sim.errors import ConfigError
 
@@ -52,8 +54,8 @@ class AckermannConfig:
     name: str
     rear_wheel: str = "rear_wheel_joint"
     front_steer: str = "front_steer_joint"
-    wheel_separation_h: Optional[float] = None
-    wheel_radius: Optional[float] = None
+    wheel_separation_h: float | None = None
+    wheel_radius: float | None = None
     wheel_separation_h_multiplier: float = 1.0
     wheel_radius_multiplier: float = 1.0
     steer_pos_multiplier: float = 1.0
@@ -65,12 +67,12 @@ class AckermannConfig:
     base_frame_id: str = "base_link"
     odom_frame_id: str = "odom"
     enable_odom_tf: bool = True
-    pose_covariance_diagonal: Tuple[float, ...] = (0.0,) * 6
-    twist_covariance_diagonal: Tuple[float, ...] = (0.0,) * 6
+    pose_covariance_diagonal: tuple[float, ...] = (0.0,) * 6
+    twist_covariance_diagonal: tuple[float, ...] = (0.0,) * 6
     linear: AxisLimits = field(default_factory=AxisLimits)
     angular: AxisLimits = field(default_factory=AxisLimits)
-    unknown_keys: Tuple[str, ...] = ()
-    warnings: Tuple[str, ...] = ()
+    unknown_keys: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
 
     @property
     def publish_period(self):

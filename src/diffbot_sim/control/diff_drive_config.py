@@ -10,7 +10,6 @@ defaults substituted where upstream would fail are said in ``warnings``. The con
 """
 import math
 from dataclasses import asdict, dataclass, field
-from typing import Optional, Tuple
 
 from diffbot_sim.control.limits import SpeedLimiter
 from diffbot_sim.errors import ConfigError
@@ -64,16 +63,16 @@ class DiffDriveControllerConfig:
     """
 
     name: str
-    left_wheels: Tuple[str, ...]
-    right_wheels: Tuple[str, ...]
-    wheel_separation: Optional[float] = None
-    wheel_radius: Optional[float] = None
+    left_wheels: tuple[str, ...]
+    right_wheels: tuple[str, ...]
+    wheel_separation: float | None = None
+    wheel_radius: float | None = None
     wheel_separation_multiplier: float = 1.0
     left_wheel_radius_multiplier: float = 1.0
     right_wheel_radius_multiplier: float = 1.0
     publish_rate: float = 50.0
-    pose_covariance_diagonal: Tuple[float, ...] = (0.0,) * 6
-    twist_covariance_diagonal: Tuple[float, ...] = (0.0,) * 6
+    pose_covariance_diagonal: tuple[float, ...] = (0.0,) * 6
+    twist_covariance_diagonal: tuple[float, ...] = (0.0,) * 6
     open_loop: bool = False
     velocity_rolling_window_size: int = 10
     cmd_vel_timeout: float = 0.5
@@ -85,9 +84,9 @@ class DiffDriveControllerConfig:
     publish_wheel_joint_controller_state: bool = False
     linear: AxisLimits = field(default_factory=AxisLimits)
     angular: AxisLimits = field(default_factory=AxisLimits)
-    unknown_keys: Tuple[str, ...] = ()
-    unsupported: Tuple[str, ...] = ()
-    warnings: Tuple[str, ...] = ()
+    unknown_keys: tuple[str, ...] = ()
+    unsupported: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
 
     @property
     def publish_period(self):

@@ -32,7 +32,6 @@ overshoots), :func:`stable_gain` gives the gain of the exact discrete form of th
 """
 import math
 from dataclasses import dataclass, replace
-from typing import Optional
 
 from diffbot_sim.control.pid import STABILITY_MARGIN
 from diffbot_sim.transforms import wrap_angle
@@ -54,7 +53,7 @@ class Variant:
 
     filename: str
     source: str  # repository and file it was read from
-    cmd_vel_timeout: Optional[float]  # default of <cmdVelTimeOut> [s]; None: the copy has no timeout (no tag)
+    cmd_vel_timeout: float | None  # default of <cmdVelTimeOut> [s]; None: the copy has no timeout (no tag)
 
 
 VARIANTS = {v.filename: v for v in (
@@ -75,13 +74,13 @@ VARIANTS = {v.filename: v for v in (
 class ForceBasedMoveConfig:
     """The plugin's tags, read once (defaults as upstream)."""
 
-    robot_namespace: Optional[str] = None  # None: absent (the spawner's namespace applies)
+    robot_namespace: str | None = None  # None: absent (the spawner's namespace applies)
     command_topic: str = "cmd_vel"
     odometry_topic: str = "odom"
     odometry_frame: str = "odom"
     robot_base_frame: str = "base_footprint"
     odometry_rate: float = 20.0  # Hz; <= 0: no odometry and no TF
-    cmd_vel_timeout: Optional[float] = 0.25  # s; None: none (the last command holds)
+    cmd_vel_timeout: float | None = 0.25  # s; None: none (the last command holds)
     publish_odometry_tf: bool = True
     x_gain: float = 10000.0  # N per m/s
     y_gain: float = 10000.0  # N per m/s

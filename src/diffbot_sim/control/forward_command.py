@@ -28,7 +28,6 @@ topic); the ROS plumbing (subscribers, publishers, realtime buffers).
 """
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Optional, Tuple
 
 from diffbot_sim.control.angles import shortest_angular_distance, shortest_angular_distance_with_large_limits
 from diffbot_sim.control.pid import Pid, PidGains, no_p_gain_message, pid_gains, pid_publish_state
@@ -86,11 +85,11 @@ class ForwardConfig:
     interface: str
     kind: str
     single: bool
-    joints: Tuple[str, ...]
-    specs: Tuple[JointSpec, ...] = ()
-    gains: Tuple[PidGains, ...] = ()
-    pid_namespaces: Tuple[str, ...] = ()
-    publish_pid_state: Tuple[bool, ...] = ()
+    joints: tuple[str, ...]
+    specs: tuple[JointSpec, ...] = ()
+    gains: tuple[PidGains, ...] = ()
+    pid_namespaces: tuple[str, ...] = ()
+    publish_pid_state: tuple[bool, ...] = ()
 
 
 def forward_config(params, name, controller_type, joint_names_in_model):
@@ -194,7 +193,7 @@ class ForwardCommandCore:
         else:
             self.commands = [0.0] * len(self.config.joints)
 
-    def command(self, values) -> Optional[str]:
+    def command(self, values) -> str | None:
         """Take a ``command`` message's value(s); a wrong length returns upstream's error line and keeps the
         previous command (also accepted while stopped: ``start`` then overrides it, as upstream)."""
         values = _as_values(values, self.config)
@@ -254,7 +253,7 @@ class PidPositionCore:
         self.pids = [Pid(gains) for gains in config.gains]
         self.commands = [0.0] * len(config.joints)
         self.loop_count = 0
-        self.state: Optional[JointControllerState] = None
+        self.state: JointControllerState | None = None
 
     def start(self, positions):
         """Hold the current positions (clamped to the URDF limits) and reset the PIDs."""

@@ -18,14 +18,15 @@ virtual middle wheel each, and a speed); whichever arrived last drives. Upstream
 """
 import math
 from dataclasses import dataclass, field
-from typing import NamedTuple, Tuple
+from typing import NamedTuple
 
-from diffbot_sim.control.ackermann_steering_controller import (RollingMean, covariances, frame_id,
-                                                               rolling_window)
-from diffbot_sim.control.diff_drive_config import AxisLimits
-from diffbot_sim.control.diff_drive_config import _axis_limits as axis_limits
-from diffbot_sim.control.diff_drive_config import _bool as check_bool
-from diffbot_sim.control.diff_drive_config import _number as check_number
+from diffbot_sim.control.ackermann_steering_controller import RollingMean, covariances, frame_id, rolling_window
+from diffbot_sim.control.diff_drive_config import (
+    AxisLimits,
+    _axis_limits as axis_limits,
+    _bool as check_bool,
+    _number as check_number,
+)
 from diffbot_sim.errors import ConfigError
 
 CONTROLLER_TYPE = "four_wheel_steering_controller/FourWheelSteeringController"
@@ -43,10 +44,10 @@ class FourWheelSteeringConfig:
     """A FourWheelSteeringController's parameters, checked; joint pairs are (left, right)."""
 
     name: str
-    front_wheels: Tuple[str, str]
-    rear_wheels: Tuple[str, str]
-    front_steerings: Tuple[str, str]
-    rear_steerings: Tuple[str, str]
+    front_wheels: tuple[str, str]
+    rear_wheels: tuple[str, str]
+    front_steerings: tuple[str, str]
+    rear_steerings: tuple[str, str]
     track: float = None
     wheel_radius: float = None
     wheel_base: float = None
@@ -56,12 +57,12 @@ class FourWheelSteeringConfig:
     cmd_vel_timeout: float = 0.5
     base_frame_id: str = "base_link"
     enable_odom_tf: bool = True
-    pose_covariance_diagonal: Tuple[float, ...] = (0.0,) * 6
-    twist_covariance_diagonal: Tuple[float, ...] = (0.0,) * 6
+    pose_covariance_diagonal: tuple[float, ...] = (0.0,) * 6
+    twist_covariance_diagonal: tuple[float, ...] = (0.0,) * 6
     linear: AxisLimits = field(default_factory=AxisLimits)
     angular: AxisLimits = field(default_factory=AxisLimits)
-    unknown_keys: Tuple[str, ...] = ()
-    warnings: Tuple[str, ...] = ()
+    unknown_keys: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
 
     @property
     def publish_period(self):
@@ -334,8 +335,8 @@ class FourWheelSteeringStep(NamedTuple):
     """Commands for (fl, fr, rl, rr) wheels [rad/s] and steerings [rad]; publish odom now; skipped (NaN
     joint readings: no odometry this update, the commands are still computed as upstream)."""
 
-    wheels: Tuple[float, float, float, float]
-    steerings: Tuple[float, float, float, float]
+    wheels: tuple[float, float, float, float]
+    steerings: tuple[float, float, float, float]
     publish_odom: bool
     front_steering: float = 0.0
     rear_steering: float = 0.0

@@ -10,7 +10,6 @@ The gripper, franka_gazebo's FrankaGripperSim, is :mod:`diffbot_sim.control.fran
 """
 import math
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional
 
 import numpy as np
 
@@ -70,27 +69,27 @@ class FrankaHWConfig:
     readParameters read them."""
 
     arm_id: str
-    arm_joints: List[str]  # <arm_id>_joint1..7
-    finger_joints: List[str]  # the model's <arm_id>_finger_joint1/2 that have a transmission
+    arm_joints: list[str]  # <arm_id>_joint1..7
+    finger_joints: list[str]  # the model's <arm_id>_finger_joint1/2 that have a transmission
     tau_ext_lowpass_filter: float
     singularity_warning_threshold: float
-    gravity_vector: Optional[tuple]  # None: the world's gravity
+    gravity_vector: tuple | None  # None: the world's gravity
     m_ee: float
-    I_ee: tuple  # noqa: N815 (libfranka's names)
-    F_x_Cee: tuple  # noqa: N815
-    F_T_NE: tuple  # noqa: N815
-    NE_T_EE: tuple  # noqa: N815
-    EE_T_K: tuple  # noqa: N815
+    I_ee: tuple  # libfranka's names, as the fields below
+    F_x_Cee: tuple
+    F_T_NE: tuple
+    NE_T_EE: tuple
+    EE_T_K: tuple
     m_load: float
-    I_load: tuple  # noqa: N815
-    F_x_Cload: tuple  # noqa: N815
+    I_load: tuple
+    F_x_Cload: tuple
     lower_torque_thresholds: tuple
     upper_torque_thresholds: tuple
     lower_force_thresholds: tuple
     upper_force_thresholds: tuple
-    position_gains: Dict[str, object]  # joint -> PidGains (motion_generators/position/gains/<joint>)
-    velocity_gains: Dict[str, object]  # joint -> PidGains (motion_generators/velocity/gains/<joint>)
-    warnings: List[str] = field(default_factory=list)
+    position_gains: dict[str, object]  # joint -> PidGains (motion_generators/position/gains/<joint>)
+    velocity_gains: dict[str, object]  # joint -> PidGains (motion_generators/velocity/gains/<joint>)
+    warnings: list[str] = field(default_factory=list)
 
 
 def franka_hw_config(params, ns, robot_namespace, model_joints, hand_mass):
@@ -321,34 +320,34 @@ class FrankaState:
     """libfranka's RobotState as FrankaHWSim fills it (the fields franka_msgs/FrankaState carries; what it leaves
     at zero stays zero: elbow, O_T_EE_d/_c, errors)."""
 
-    q: List[float] = field(default_factory=lambda: [0.0] * 7)
-    q_d: List[float] = field(default_factory=lambda: [0.0] * 7)
-    dq: List[float] = field(default_factory=lambda: [0.0] * 7)
-    dq_d: List[float] = field(default_factory=lambda: [0.0] * 7)
-    ddq_d: List[float] = field(default_factory=lambda: [0.0] * 7)
-    tau_J: List[float] = field(default_factory=lambda: [0.0] * 7)  # noqa: N815
-    dtau_J: List[float] = field(default_factory=lambda: [0.0] * 7)  # noqa: N815
-    tau_J_d: List[float] = field(default_factory=lambda: [0.0] * 7)  # noqa: N815
-    tau_ext_hat_filtered: List[float] = field(default_factory=lambda: [0.0] * 7)
-    joint_contact: List[float] = field(default_factory=lambda: [0.0] * 7)
-    joint_collision: List[float] = field(default_factory=lambda: [0.0] * 7)
-    cartesian_contact: List[float] = field(default_factory=lambda: [0.0] * 6)
-    cartesian_collision: List[float] = field(default_factory=lambda: [0.0] * 6)
-    O_F_ext_hat_K: List[float] = field(default_factory=lambda: [0.0] * 6)  # noqa: N815
-    K_F_ext_hat_K: List[float] = field(default_factory=lambda: [0.0] * 6)  # noqa: N815
-    O_T_EE: tuple = (0.0,) * 16  # noqa: N815
-    F_T_EE: tuple = IDENTITY16  # noqa: N815
-    F_T_NE: tuple = IDENTITY16  # noqa: N815
-    NE_T_EE: tuple = IDENTITY16  # noqa: N815
-    EE_T_K: tuple = IDENTITY16  # noqa: N815
+    q: list[float] = field(default_factory=lambda: [0.0] * 7)
+    q_d: list[float] = field(default_factory=lambda: [0.0] * 7)
+    dq: list[float] = field(default_factory=lambda: [0.0] * 7)
+    dq_d: list[float] = field(default_factory=lambda: [0.0] * 7)
+    ddq_d: list[float] = field(default_factory=lambda: [0.0] * 7)
+    tau_J: list[float] = field(default_factory=lambda: [0.0] * 7)
+    dtau_J: list[float] = field(default_factory=lambda: [0.0] * 7)
+    tau_J_d: list[float] = field(default_factory=lambda: [0.0] * 7)
+    tau_ext_hat_filtered: list[float] = field(default_factory=lambda: [0.0] * 7)
+    joint_contact: list[float] = field(default_factory=lambda: [0.0] * 7)
+    joint_collision: list[float] = field(default_factory=lambda: [0.0] * 7)
+    cartesian_contact: list[float] = field(default_factory=lambda: [0.0] * 6)
+    cartesian_collision: list[float] = field(default_factory=lambda: [0.0] * 6)
+    O_F_ext_hat_K: list[float] = field(default_factory=lambda: [0.0] * 6)
+    K_F_ext_hat_K: list[float] = field(default_factory=lambda: [0.0] * 6)
+    O_T_EE: tuple = (0.0,) * 16
+    F_T_EE: tuple = IDENTITY16
+    F_T_NE: tuple = IDENTITY16
+    NE_T_EE: tuple = IDENTITY16
+    EE_T_K: tuple = IDENTITY16
     m_ee: float = 0.0
-    I_ee: tuple = (0.0,) * 9  # noqa: N815
-    F_x_Cee: tuple = (0.0,) * 3  # noqa: N815
+    I_ee: tuple = (0.0,) * 9
+    F_x_Cee: tuple = (0.0,) * 3
     m_load: float = 0.0
-    I_load: tuple = (0.0,) * 9  # noqa: N815
-    F_x_Cload: tuple = (0.0,) * 3  # noqa: N815
+    I_load: tuple = (0.0,) * 9
+    F_x_Cload: tuple = (0.0,) * 3
     m_total: float = 0.0
-    I_total: tuple = (0.0,) * 9  # noqa: N815
+    I_total: tuple = (0.0,) * 9
     time: float = 0.0
     robot_mode: int = IDLE
 

@@ -18,7 +18,6 @@ position is half the width (MoveIt commands one finger) and it moves (``max_effo
 """
 import math
 from dataclasses import dataclass
-from typing import List, Optional
 
 from diffbot_sim.control.pid import Pid, pid_gains
 from diffbot_sim.errors import ConfigError
@@ -129,9 +128,9 @@ class FrankaGripperCore:
         self.cfg = cfg
         self.pid1, self.pid2 = Pid(cfg.gains1), Pid(cfg.gains2)
         self.state, self.target = IDLE, Target()
-        self.job: Optional[Job] = None
+        self.job: Job | None = None
         self._resting = 0
-        self._finished: List[Finished] = []
+        self._finished: list[Finished] = []
 
     def starting(self):
         self.state, self.target = IDLE, Target()

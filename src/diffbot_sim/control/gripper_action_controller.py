@@ -30,8 +30,9 @@ cancelled in that gap is cancelled upstream; here it has already finished. No fe
 upstream, nor here.
 """
 import math
+from collections.abc import Hashable
 from dataclasses import dataclass
-from typing import Hashable, NamedTuple, Optional, Tuple
+from typing import NamedTuple
 
 from diffbot_sim.control.pid import Pid, PidGains, no_p_gain_message, pid_gains
 from diffbot_sim.errors import ConfigError
@@ -66,8 +67,8 @@ class GripperActionConfig:
     stall_velocity_threshold: float = 0.001
     stall_timeout: float = 1.0
     action_monitor_rate: float = 20.0
-    gains: Optional[PidGains] = None
-    warnings: Tuple[str, ...] = ()
+    gains: PidGains | None = None
+    warnings: tuple[str, ...] = ()
 
     @property
     def action_monitor_period(self):
@@ -148,7 +149,7 @@ class GripperUpdate(NamedTuple):
 
     command: float
     effort: float
-    events: Tuple[GripperEvent, ...]
+    events: tuple[GripperEvent, ...]
 
 
 class GripperActionCore:

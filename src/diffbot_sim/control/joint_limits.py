@@ -28,7 +28,6 @@ wrongly typed value raises ConfigError); MoveIt's other joint_limits keys. A ``<
 import math
 import sys
 from dataclasses import dataclass, replace
-from typing import Optional
 
 from diffbot_sim.errors import ConfigError, DiffbotSimError
 from diffbot_sim.values import check_number
@@ -364,8 +363,8 @@ class RegisteredLimits:
     lower: float  # rad or m; -DBL_MAX without position limits
     upper: float  # +DBL_MAX without position limits
     effort_limit: float  # N·m or N; DBL_MAX without effort limits
-    limits: Optional[JointLimits] = None
-    soft: Optional[SoftJointLimits] = None
+    limits: JointLimits | None = None
+    soft: SoftJointLimits | None = None
     handle: object = None
 
 

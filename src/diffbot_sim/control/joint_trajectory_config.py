@@ -7,7 +7,6 @@ upstream logs while loading is kept in ``log``, and a controller upstream loads 
 so in ``start_crash``. The controller that runs on it is :mod:`diffbot_sim.control.joint_trajectory_controller`.
 """
 from dataclasses import dataclass
-from typing import Optional, Tuple
 
 from diffbot_sim.control.pid import PidGains, no_p_gain_message, pid_gains
 from diffbot_sim.control.trajectory import SegmentTolerances, StateTolerances
@@ -39,17 +38,17 @@ class JtcConfig:
     name: str
     controller_type: str
     variant: str
-    joints: Tuple[str, ...]
-    wraparound: Tuple[bool, ...]
-    default_tolerances: Tuple[SegmentTolerances, ...]
+    joints: tuple[str, ...]
+    wraparound: tuple[bool, ...]
+    default_tolerances: tuple[SegmentTolerances, ...]
     state_publish_rate: float = 50.0
     action_monitor_rate: float = 20.0
     stop_trajectory_duration: float = 0.0
     allow_partial_joints_goal: bool = False
-    gains: Tuple[PidGains, ...] = ()
-    velocity_ff: Tuple[float, ...] = ()
-    log: Tuple[Tuple[str, str], ...] = ()
-    start_crash: Optional[str] = None
+    gains: tuple[PidGains, ...] = ()
+    velocity_ff: tuple[float, ...] = ()
+    log: tuple[tuple[str, str], ...] = ()
+    start_crash: str | None = None
 
 
 def jtc_config(params, name, joints):

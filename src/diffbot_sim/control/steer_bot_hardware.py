@@ -20,7 +20,6 @@ driven by SetVelocity and the gains are never used.
 """
 import math
 from dataclasses import dataclass
-from typing import Tuple
 
 from diffbot_sim.errors import ConfigError
 
@@ -35,9 +34,9 @@ class SteerBotConfig:
 
     rear_wheel: str
     front_steer: str
-    virtual_rear_wheels: Tuple[str, str]
-    virtual_front_wheels: Tuple[str, str]
-    virtual_front_steers: Tuple[str, str]
+    virtual_rear_wheels: tuple[str, str]
+    virtual_front_wheels: tuple[str, str]
+    virtual_front_steers: tuple[str, str]
     enable_ackermann_link: bool = True
     wheel_separation_w: float = 0.0
     wheel_separation_h: float = 0.0

@@ -5,8 +5,8 @@ Turn in place towards the next waypoint, then drive to it, steering; a waypoint 
 ``tolerance``. Pose in, (linear, angular) command out; the caller passes the time and the pose.
 """
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import List, Sequence, Tuple
 
 from diffbot_sim.transforms import wrap_angle
 
@@ -25,8 +25,8 @@ class TourConfig:
 class Tour:
     """Where the robot is in its list of waypoints and what it should do now."""
 
-    def __init__(self, waypoints: Sequence[Tuple[float, float]], config: TourConfig = TourConfig()):
-        self.waypoints: List[Tuple[float, float]] = [(float(x), float(y)) for x, y in waypoints]
+    def __init__(self, waypoints: Sequence[tuple[float, float]], config: TourConfig = TourConfig()):
+        self.waypoints: list[tuple[float, float]] = [(float(x), float(y)) for x, y in waypoints]
         self.config = config
         self.index = 0
 

@@ -17,7 +17,7 @@ Gazebo 11's) lumped every fixed joint's child into its parent (``parser_urdf.cc`
 URDF ``<collision name="...">`` attributes are not read here (the model keeps none): collisions are named after
 their links, as in most published URDFs.
 """
-from typing import Dict, List, NamedTuple, Optional, Tuple
+from typing import NamedTuple
 
 LUMP = "_fixed_joint_lump__"
 COLLISION = "_collision"
@@ -47,15 +47,15 @@ def kept_fixed_joints(model):
 def gazebo_links(model):
     """({URDF link: the Gazebo link it became part of}, {Gazebo link: [GazeboCollision, ...]}) of ``model``."""
     kept = kept_fixed_joints(model)
-    children: Dict[str, List[Tuple[str, object]]] = {}
+    children: dict[str, list[tuple[str, object]]] = {}
     for joint in model.joints.values():  # URDF order
         children.setdefault(joint.parent, []).append((joint.child, joint))
 
     def lumped(joint):
         return joint.type == "fixed" and joint.name not in kept and joint.parent != "world"
 
-    owner: Dict[str, str] = {}
-    raw: Dict[str, List[Tuple[str, str, int]]] = {}  # Gazebo link -> [(base name, URDF link, index)]
+    owner: dict[str, str] = {}
+    raw: dict[str, list[tuple[str, str, int]]] = {}  # Gazebo link -> [(base name, URDF link, index)]
 
     def reduce(link, into):
         owner[link] = into
@@ -69,7 +69,7 @@ def gazebo_links(model):
         return entries
 
     raw.setdefault(model.root, []).extend(reduce(model.root, model.root))
-    named: Dict[str, List[GazeboCollision]] = {}
+    named: dict[str, list[GazeboCollision]] = {}
     for link, entries in raw.items():
         out = []
         for count, (base, urdf_link, index) in enumerate(entries):
@@ -89,5 +89,5 @@ def sensor_collision(model, sensor_link, collision):
     name = collision.strip()
     if link != sensor_link and name == sensor_link + COLLISION:
         name = f"{link}{COLLISION}_{sensor_link}"  # sdformat's rewrite of a lumped link's contact sensor
-    found: Optional[GazeboCollision] = next((c for c in named.get(link, ()) if c.name == name), None)
+    found: GazeboCollision | None = next((c for c in named.get(link, ()) if c.name == name), None)
     return found, name

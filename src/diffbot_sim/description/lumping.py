@@ -33,7 +33,6 @@ them unmerged costs ~25 %.
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
-from typing import Dict, List, Tuple
 
 import numpy as np
 
@@ -57,9 +56,9 @@ class LumpedUrdf:
     """
 
     text: str
-    frames: Dict[str, Tuple[str, Tuple[float, float, float], Tuple[float, float, float, float]]]
-    lumped: List[str] = field(default_factory=list)  # links merged into another
-    placeholders: List[str] = field(default_factory=list)  # links given a placeholder mass
+    frames: dict[str, tuple[str, tuple[float, float, float], tuple[float, float, float, float]]]
+    lumped: list[str] = field(default_factory=list)  # links merged into another
+    placeholders: list[str] = field(default_factory=list)  # links given a placeholder mass
 
 
 def matrix_quaternion(m):

@@ -44,7 +44,7 @@ def load_file(path, args=None):
     try:
         doc = xacro.process_file(path, mappings=dict(args or {}))
         return doc.toprettyxml(indent="  ")
-    except Exception as err:  # noqa: BLE001 - xacro raises XacroException, ExpatError, IOError, NameError...
+    except Exception as err:  # xacro raises XacroException, ExpatError, IOError, NameError...
         detail = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
         raise ModelError(f"xacro failed: {detail}", path) from None
     finally:

@@ -10,7 +10,6 @@ import math
 import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional
 
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ConfigError, ModelError
@@ -53,9 +52,9 @@ class PluginBlock:
 
     path: str
     dialect: str  # "ros1" or "ros2"
-    values: Dict[str, object] = field(default_factory=dict)
-    unknown_tags: List[str] = field(default_factory=list)
-    tags: Dict[str, str] = field(default_factory=dict)  # canonical key -> the tag as written
+    values: dict[str, object] = field(default_factory=dict)
+    unknown_tags: list[str] = field(default_factory=list)
+    tags: dict[str, str] = field(default_factory=dict)  # canonical key -> the tag as written
 
     def tag(self, key):
         """The tag the model used for a canonical key (for error messages that point at the file)."""
@@ -79,20 +78,20 @@ class SensorElement:
 
     type: str
     name: str
-    link: Optional[str]
+    link: str | None
     element: ET.Element
     path: str
-    plugins: List[str] = field(default_factory=list)
+    plugins: list[str] = field(default_factory=list)
 
 
 @dataclass
 class Plugins:
-    diff_drive: Optional[PluginBlock] = None
-    joint_state: Optional[PluginBlock] = None
-    others: List[PluginElement] = field(default_factory=list)  # every other plugin, in model order
-    sensors: List[SensorElement] = field(default_factory=list)  # every <sensor>, in model order
-    unsupported: List[str] = field(default_factory=list)  # plugins and sensors we do not simulate
-    warnings: List[str] = field(default_factory=list)
+    diff_drive: PluginBlock | None = None
+    joint_state: PluginBlock | None = None
+    others: list[PluginElement] = field(default_factory=list)  # every other plugin, in model order
+    sensors: list[SensorElement] = field(default_factory=list)  # every <sensor>, in model order
+    unsupported: list[str] = field(default_factory=list)  # plugins and sensors we do not simulate
+    warnings: list[str] = field(default_factory=list)
 
 
 def plugin_filename(text):

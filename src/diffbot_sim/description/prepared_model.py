@@ -9,7 +9,7 @@ sensors read (:mod:`.plugin_tags`), and every transmission's joint looked up (a 
 model lacks is an error naming the transmission, as gazebo_ros_control's loader refuses it).
 """
 import os
-from typing import List, NamedTuple
+from typing import NamedTuple
 
 from diffbot_sim.description import meshes, xml_documents
 from diffbot_sim.description.model_files import load_file, package_path, parse_args
@@ -32,7 +32,7 @@ class PreparedModel(NamedTuple):
     text: str
     model: RobotModel
     plugins: Plugins
-    notes: List[str]
+    notes: list[str]
 
 
 def read_model_file(path, model_args=""):

@@ -8,7 +8,6 @@ the source and the element, e.g. ``/robot/transmission[@name='left_trans']/joint
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Tuple
 
 from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.values import tag_number
@@ -33,7 +32,7 @@ WORLD_LINK = "world"
 #: Joint interfaces a transmission may declare (ros_control's, without the ``hardware_interface/`` prefix).
 JOINT_INTERFACES = ("VelocityJointInterface", "EffortJointInterface", "PositionJointInterface")
 
-Vec3 = Tuple[float, float, float]
+Vec3 = tuple[float, float, float]
 
 
 @dataclass(frozen=True)
@@ -41,15 +40,15 @@ class Geometry:
     """A collision shape: ``kind`` is cylinder, sphere, box or mesh; sizes in m."""
 
     kind: str
-    radius: Optional[float] = None
-    length: Optional[float] = None
+    radius: float | None = None
+    length: float | None = None
 
 
 @dataclass
 class Link:
     name: str
-    mass: Optional[float]  # None: the link has no <inertial> (e.g. base_footprint)
-    collisions: List[Geometry] = field(default_factory=list)
+    mass: float | None  # None: the link has no <inertial> (e.g. base_footprint)
+    collisions: list[Geometry] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -80,13 +79,13 @@ class Joint:
     xyz: Vec3 = (0.0, 0.0, 0.0)
     rpy: Vec3 = (0.0, 0.0, 0.0)
     axis: Vec3 = (1.0, 0.0, 0.0)
-    effort_limit: Optional[float] = None  # N·m (or N); None when the URDF gives no <limit effort>
-    velocity_limit: Optional[float] = None  # rad/s (or m/s)
+    effort_limit: float | None = None  # N·m (or N); None when the URDF gives no <limit effort>
+    velocity_limit: float | None = None  # rad/s (or m/s)
     has_limit: bool = False  # the joint has a <limit> element (joint_limits_interface reads limits only then)
     lower: float = 0.0  # rad (or m), <limit lower>; URDF's default 0
     upper: float = 0.0  # rad (or m), <limit upper>
-    mimic: Optional[Mimic] = None
-    safety: Optional[SafetyController] = None
+    mimic: Mimic | None = None
+    safety: SafetyController | None = None
 
     @property
     def movable(self):
@@ -110,7 +109,7 @@ class Transmission:
     type: str
     joint: str
     interface: str  # one of JOINT_INTERFACES
-    actuator: Optional[str] = None
+    actuator: str | None = None
     reduction: float = 1.0
     offset: float = 0.0
 
@@ -142,10 +141,10 @@ class OtherTransmission:
 
     name: str
     type: str
-    joints: List[str]
-    interfaces: List[str]  # each joint's first <hardwareInterface>, as written ("" when it has none)
+    joints: list[str]
+    interfaces: list[str]  # each joint's first <hardwareInterface>, as written ("" when it has none)
     why: str  # why DefaultRobotHWSim skips it
-    roles: List[str] = field(default_factory=list)  # each joint's <role> (franka_hw's root and tip), "" if none
+    roles: list[str] = field(default_factory=list)  # each joint's <role> (franka_hw's root and tip), "" if none
 
     @property
     def warning(self):
@@ -156,7 +155,7 @@ class OtherTransmission:
 class GazeboBlock:
     """A ``<gazebo>`` element; ``reference`` is the link (or joint) it applies to, None for the robot."""
 
-    reference: Optional[str]
+    reference: str | None
     element: ET.Element
     path: str
 
@@ -165,21 +164,21 @@ class GazeboBlock:
 class RobotModel:
     name: str
     source: str
-    links: Dict[str, Link]
-    joints: Dict[str, Joint]
-    transmissions: List[Transmission]
-    gazebo: List[GazeboBlock]
+    links: dict[str, Link]
+    joints: dict[str, Joint]
+    transmissions: list[Transmission]
+    gazebo: list[GazeboBlock]
     #: The model's canonical link, the one /gazebo names first and PyBullet's base: the URDF's root link; for a
     #: robot joined to the world by one fixed joint from ``world``, that joint's child; ``world`` itself (a
     #: massless stand-in for the world, fixed) when it is joined by a movable joint or by several.
     root: str
     #: The joints from ``world`` (WORLD_LINK): each holds the robot to the world as Gazebo's joint to the world
     #: does (the model's base is fixed where it is spawned). Empty for a free robot.
-    world_joints: List[Joint] = field(default_factory=list)
-    warnings: List[str] = field(default_factory=list)  # published mistakes survived, one line each
+    world_joints: list[Joint] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)  # published mistakes survived, one line each
     #: The transmissions DefaultRobotHWSim does not simulate (``transmissions`` holds those it does).
-    other_transmissions: List[OtherTransmission] = field(default_factory=list)
-    _surfaces: Dict[str, dict] = field(default_factory=dict, repr=False)
+    other_transmissions: list[OtherTransmission] = field(default_factory=list)
+    _surfaces: dict[str, dict] = field(default_factory=dict, repr=False)
 
     @property
     def fixed_to_world(self):

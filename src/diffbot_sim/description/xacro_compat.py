@@ -137,8 +137,8 @@ def _loader_class(xacro):
                 text = loader.construct_scalar(node)
                 try:
                     # an xacro expression, as noetic reads it: `!radians pi/2`
-                    return float(eval(str(text), xacro.global_symbols, {})) * factor  # noqa: S307
-                except Exception as err:  # noqa: BLE001 - any bad expression is a YAML content error
+                    return float(eval(str(text), xacro.global_symbols, {})) * factor
+                except Exception as err:  # any bad expression is a YAML content error
                     problem = f"{tag} needs a number or an expression like pi/2, got '{text}' ({err})"
                     raise yaml.constructor.ConstructorError(None, None, problem, node.start_mark) from None
             return constructor
@@ -161,7 +161,7 @@ def _make_load_yaml(xacro):
         oldstack = xacro.push_file(path)  # errors inside (a bad !degrees expression) name the YAML file
         try:
             with open(path, encoding="utf-8") as handle:
-                data = yaml.load(handle, Loader=_loader_class(xacro))  # noqa: S506 - a SafeLoader subclass
+                data = yaml.load(handle, Loader=_loader_class(xacro))  # a SafeLoader subclass
         except yaml.YAMLError as err:
             raise xacro.XacroException(f"invalid YAML in {path}:", exc=err) from None
         finally:

@@ -15,7 +15,6 @@ Remapping arguments, one-line errors and help: :mod:`diffbot_sim.gazebo.cli`.
 import os
 import sys
 from dataclasses import dataclass
-from typing import List, Optional
 
 import yaml
 
@@ -47,12 +46,12 @@ def parse_or_status(parse, prog, argv):
 class SpawnerArgs:
     """A parsed ``spawner`` command line. ``timeout`` None waits forever; ``shutdown_timeout`` None: unbounded."""
 
-    controllers: List[str]
+    controllers: list[str]
     stopped: bool = False
-    wait_for: Optional[str] = None
+    wait_for: str | None = None
     namespace: str = ""
-    timeout: Optional[float] = SPAWNER_TIMEOUT
-    shutdown_timeout: Optional[float] = None
+    timeout: float | None = SPAWNER_TIMEOUT
+    shutdown_timeout: float | None = None
 
 
 def _spawner_parser():
@@ -220,7 +219,7 @@ class ManagerCommand:
     """A ``controller_manager`` command: the canonical verb, its controller names, ``--restore``."""
 
     verb: str
-    names: List[str]
+    names: list[str]
     restore: bool = False
 
 
@@ -248,7 +247,7 @@ def format_controller(state):
     set of claimed hardware interfaces in set order; here sorted, so the line is stable.
     """
     interfaces = sorted({res.hardware_interface for res in state.claimed_resources})
-    return "'%s' - '%s' ( %s )" % (state.name, "+".join(interfaces), state.state)
+    return f"'{state.name}' - '{'+'.join(interfaces)}' ( {state.state} )"
 
 
 def format_controller_list(states):

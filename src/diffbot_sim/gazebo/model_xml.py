@@ -290,10 +290,7 @@ def sdf_model_at(xml, pose):
     (x, y, z), q = compose(pose, file_pose)
     text = " ".join(repr(float(v)) for v in (x, y, z) + quaternion_rpy(q))
     new = b"<pose>" + text.encode("ascii") + b"</pose>"
-    if pose_el is not None:
-        edit = (pose_el.start, pose_el.end, new)
-    else:
-        edit = _append_child(target, new)
+    edit = (pose_el.start, pose_el.end, new) if pose_el is not None else _append_child(target, new)
     start, end = target.start, target.end
     shifted = (edit[0] - start, edit[1] - start, edit[2])
     return _splice(data[start:end], [shifted]).decode("utf-8")

@@ -14,7 +14,6 @@ arguments, one-line errors and help: :mod:`diffbot_sim.gazebo.cli`.
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
-from typing import List, Optional, Tuple
 from urllib.parse import urlsplit, urlunsplit
 
 from diffbot_sim.gazebo.cli import CliError, Parser, finite, strip_remappings
@@ -41,7 +40,7 @@ class SpawnArgs:
 
     fmt: str
     source: str
-    source_value: Optional[str]
+    source_value: str | None
     model: str
     x: float = 0.0
     y: float = 0.0
@@ -49,10 +48,10 @@ class SpawnArgs:
     roll: float = 0.0
     pitch: float = 0.0
     yaw: float = 0.0
-    joints: List[Tuple[str, float]] = field(default_factory=list)
+    joints: list[tuple[str, float]] = field(default_factory=list)
     robot_namespace: str = "/"
     unpause: bool = False
-    wait: Optional[str] = None
+    wait: str | None = None
     reference_frame: str = ""
     gazebo_namespace: str = "/gazebo"
     package_to_model: bool = False

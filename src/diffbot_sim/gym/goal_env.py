@@ -35,7 +35,6 @@ Reset:
 """
 import math
 from dataclasses import dataclass, field, fields
-from typing import Optional
 
 import gymnasium
 import numpy as np
@@ -85,7 +84,7 @@ class GoalConfig:
     min_goal_distance: float = 1.0  # m between start and goal
     clearance: float = 0.1  # m around the robot's footprint that starts and goals keep from bodies
     grid: float = 0.1  # m between candidate start/goal cells
-    arena: Optional[tuple] = None  # ((x_lo, y_lo), (x_hi, y_hi)) [m]; None: the world's bounded bodies
+    arena: tuple | None = None  # ((x_lo, y_lo), (x_hi, y_hi)) [m]; None: the world's bounded bodies
     collision_range: float = 0.0  # m; > 0 also ends on a laser range below it (TurtleBot3: 0.13)
     progress_reward: float = 10.0  # per metre closer
     goal_reward: float = 10.0
@@ -104,7 +103,10 @@ def goal_config(**kwargs):
         if key not in known:
             raise ConfigError(f"GoalEnv {key}", kwargs[key], f"one of the keywords {', '.join(sorted(known))}")
     cfg = GoalConfig(**kwargs)
-    name = lambda key: f"GoalEnv {key}"  # noqa: E731
+
+    def name(key):
+        return f"GoalEnv {key}"
+
     for key in ("model", "actions", "scan_mode"):
         setattr(cfg, key, check_string(name(key), getattr(cfg, key)))
     for key in ("model_args", "world", "sensor"):

@@ -1,6 +1,6 @@
 """gazebo_msgs/ContactsState of a contact sensor (message module only, no rospy), from
 :class:`diffbot_sim.sensors.contact.ContactState` tuples."""
-from gazebo_msgs.msg import ContactState, ContactsState
+from gazebo_msgs.msg import ContactsState, ContactState
 from geometry_msgs.msg import Vector3, Wrench
 
 

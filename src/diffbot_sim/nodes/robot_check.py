@@ -150,7 +150,7 @@ def _load_yaml(path):
         raise ModelError("no such file", path)
     try:
         docs = rosparam.load_file(path, default_namespace="/")
-    except Exception as err:  # noqa: BLE001 - rosparam raises RosParamException, yaml errors, ...
+    except Exception as err:  # rosparam raises RosParamException, yaml errors, ...
         detail = " ".join(str(err).split()) or type(err).__name__
         raise ModelError(f"not a controller YAML rosparam can load ({detail})", path) from None
     tree = {}

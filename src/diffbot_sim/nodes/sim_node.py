@@ -22,8 +22,7 @@ import os
 
 import rospy
 
-from diffbot_sim import config as cfgmod
-from diffbot_sim import streams
+from diffbot_sim import config as cfgmod, streams
 from diffbot_sim.errors import DiffbotSimError
 from diffbot_sim.simulator import link_attacher, robots
 

@@ -69,7 +69,7 @@ class Spawner:
         rospy.on_shutdown(self.shutdown)
         for name in self.controllers:
             self._load(name)
-        rospy.loginfo("Controller Spawner: Loaded controllers: %s" % ", ".join(self.loaded))
+        rospy.loginfo(f"Controller Spawner: Loaded controllers: {', '.join(self.loaded)}")
         if rospy.is_shutdown():
             return 0
         if not self.args.stopped and self.loaded:
@@ -80,7 +80,7 @@ class Spawner:
                              f"{self.cm.name('switch_controller')}: {err}")
             else:
                 if ok:
-                    rospy.loginfo("Started controllers: %s" % ", ".join(self.loaded))
+                    rospy.loginfo(f"Started controllers: {', '.join(self.loaded)}")
                 else:
                     rospy.logerr(f"Failed to start controllers: {', '.join(self.loaded)} (see the simulator's "
                                  "log for the reason)")
@@ -118,7 +118,7 @@ class Spawner:
 
         def on_msg(msg):
             last[0] = msg
-            rospy.logdebug("Heard from wait-for topic: %s" % msg.data)
+            rospy.logdebug(f"Heard from wait-for topic: {msg.data}")
 
         sub = rospy.Subscriber(topic, Bool, on_msg)
         started = time.time()

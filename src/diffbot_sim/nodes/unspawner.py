@@ -36,7 +36,7 @@ def main(argv=None):
                 running = {c.name for c in cm.controllers() if c.state == "running"}
                 to_stop = sorted(set(names) & running)
                 if to_stop:
-                    rospy.loginfo("Inhibiting controllers: %s" % ", ".join(to_stop))
+                    rospy.loginfo(f"Inhibiting controllers: {', '.join(to_stop)}")
                     cm.switch(stop=to_stop, strictness=SwitchControllerRequest.BEST_EFFORT)
                     inhibited.update(to_stop)
             except CALL_ERRORS as err:

@@ -27,6 +27,7 @@ from diffbot_sim.errors import DiffbotSimError
 from diffbot_sim.view import rviz_config
 from diffbot_sim.waiting import wait_for
 
+
 def default_template():
     """The package's ``rviz/diffbot.rviz``, found as roslaunch finds package files (rospkg): in a source
     checkout and in an install space alike, where this module lives far from the package's share folder."""

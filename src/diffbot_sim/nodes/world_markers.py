@@ -27,6 +27,7 @@ Parameters:
 
 Exit status 1, with one line, on a world file that cannot be read or a simulator that never reports.
 """
+import functools
 
 from diffbot_sim.errors import DiffbotSimError
 from diffbot_sim.nodes._entry import entry_point
@@ -64,7 +65,7 @@ def _odom_frames(sim, timeout):
     out = []
     for ns in robot_namespaces(rospy.get_param(sim + "/robots", None)):
         private = sim + "/" + ns + "/" if ns else sim + "/"
-        topic = _wait(lambda: rospy.get_param(private + "odom_topic", None), timeout,
+        topic = _wait(functools.partial(rospy.get_param, private + "odom_topic", None), timeout,
                       f"parameter {private}odom_topic (the simulator's effective settings)")
         msg = rospy.wait_for_message(topic, Odometry, timeout=timeout)
         pose = odom_offset(rospy.get_param(private + "odometry_source", "world"),

@@ -23,8 +23,9 @@ def quiet(fd):
 
 try:
     with quiet(1), quiet(2):
-        import pybullet  # noqa: F401 (the package's one import of it; the other physics modules take it from here)
-        import pybullet_data  # noqa: F401
+        # The package's one import of them; the other physics modules take them from here (`as`: re-exported).
+        import pybullet as pybullet
+        import pybullet_data as pybullet_data
 except ImportError as _missing:
     # One line and status 1, not a traceback: the usual cause is a node started by a Python other than the
     # venv's (the checkout's .venv, or an install space's PREFIX/.venv: docs/install.md).

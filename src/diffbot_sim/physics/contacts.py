@@ -4,11 +4,11 @@ PyBullet's getContactPoints gives, per point of a pair (A = the robot's link, B 
 A, the normal on B pointing toward A, the signed distance (negative: penetration), the normal force and two
 friction forces along their directions. A sensor reads them as plain tuples: :class:`ContactPoint`.
 """
-from typing import NamedTuple, Tuple
+from typing import NamedTuple
 
 from diffbot_sim.physics.client import pybullet
 
-Vec3 = Tuple[float, float, float]
+Vec3 = tuple[float, float, float]
 
 
 class ContactPoint(NamedTuple):

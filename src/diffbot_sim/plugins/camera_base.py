@@ -97,9 +97,7 @@ class CameraBase(Plugin):
         return rgb, depth
 
     def due(self, now):
-        if not self.take_due(now, self.period):
-            return False
-        return True
+        return self.take_due(now, self.period)
 
     def summary(self):
         return {summary_key("camera", self.cfg.name): cam.describe(self.cfg, self.renderer)}

@@ -11,8 +11,7 @@ logs and goes on. The decisions are :mod:`diffbot_sim.sensors.kobuki_events`.
 from diffbot_sim.plugins.base import join
 from diffbot_sim.plugins.bumper import ContactSensor
 from diffbot_sim.plugins.sensor_lookup import find_sensor
-from diffbot_sim.sensors import kobuki_events as ev
-from diffbot_sim.sensors import ray as ray_sensor
+from diffbot_sim.sensors import kobuki_events as ev, ray as ray_sensor
 from diffbot_sim.transforms import yaw_from_quaternion
 from diffbot_sim.values import tag_number
 

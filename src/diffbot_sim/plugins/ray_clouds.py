@@ -72,7 +72,10 @@ class VelodyneLaser(ray_base.RaySensorPlugin):
     def __init__(self, ctx, sensor, element, path, values):
         super().__init__(ctx, sensor, element, path)
         ns = ray_base.ros1_namespace(ctx, values)
-        label = lambda tag: f"<{tag}> of {path}"  # noqa: E731
+
+        def label(tag):
+            return f"<{tag}> of {path}"
+
         self.frame = ray_base.ros1_frame(ctx, values, sensor, path, warn=False)
         notes = ctx.warnings
         self.min_range = tag_number(label("min_range"), values.get("min_range", 0.9), notes, low=0.0)

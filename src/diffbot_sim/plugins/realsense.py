@@ -7,8 +7,9 @@ plugin's name (its ``name=`` attribute, relative to the simulator's namespace: `
 ``colorTopicName``, ``infrared1TopicName``, ``infrared2TopicName``, ``depthTopicName`` and their
 ``*CameraInfoTopicName``; frames ``colorOpticalframeName`` ... ; rates ``colorUpdateRate``,
 ``infraredUpdateRate``, ``depthUpdateRate``; depth 16UC1 mm clipped to ``rangeMinDepth``..``rangeMaxDepth``;
-``pointCloud`` and its tags are read, and the cloud is not published (one warning). Encodings rgb8 and 8UC1 (infrared), as the plugin's. A tag it does not know makes the original
-throw ("Ivalid parameter"): here one warning. Images render only while subscribed.
+``pointCloud`` and its tags are read, and the cloud is not published (one warning). Encodings rgb8 and 8UC1
+(infrared), as the plugin's. A tag it does not know makes the original throw ("Ivalid parameter"): here one
+warning. Images render only while subscribed.
 """
 import math
 

@@ -18,7 +18,6 @@ depth -> point-cloud conversion of ``gazebo_ros_openni_kinect`` (pure: numpy onl
 """
 import math
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -42,7 +41,7 @@ class CameraConfig:
     type: str
     path: str
     update_rate: float = 0.0  # Hz; 0: every physics step (Gazebo: as fast as it renders)
-    pose: Tuple[Tuple[float, float, float], Tuple[float, float, float]] = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    pose: tuple[tuple[float, float, float], tuple[float, float, float]] = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
     hfov: float = 1.047
     width: int = 320
     height: int = 240
@@ -51,7 +50,7 @@ class CameraConfig:
     far: float = 100.0
     noise_mean: float = 0.0
     noise_stddev: float = 0.0
-    warnings: List[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def encoding(self):
@@ -136,12 +135,12 @@ class Intrinsics:
 
     width: int
     height: int
-    K: List[float]
-    R: List[float]
-    P: List[float]
-    D: List[float]
+    K: list[float]
+    R: list[float]
+    P: list[float]
+    D: list[float]
     distortion_model: str = "plumb_bob"
-    warnings: List[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
 
 
 def intrinsics(width, height, hfov, cx=0.0, cy=0.0, cx_prime=0.0, focal=0.0, hack_baseline=0.0,
@@ -286,10 +285,10 @@ NUMERIC = ("update_rate", "hack_baseline", "focal_length", "cx", "cy", "cx_prime
 
 @dataclass
 class PluginTags:
-    values: Dict[str, object] = field(default_factory=dict)
-    remap: Dict[str, str] = field(default_factory=dict)  # ROS 2 <remapping> from -> to
+    values: dict[str, object] = field(default_factory=dict)
+    remap: dict[str, str] = field(default_factory=dict)  # ROS 2 <remapping> from -> to
     dialect: str = "ros1"
-    unknown: List[str] = field(default_factory=list)
+    unknown: list[str] = field(default_factory=list)
 
 
 def read_plugin(element, path):
@@ -348,6 +347,6 @@ def effective_period(sensor_rate, plugin_rate):
     return 1.0 / min(rates) if rates else 0.0
 
 
-def describe(cfg: CameraConfig, renderer: Optional[str] = None):
+def describe(cfg: CameraConfig, renderer: str | None = None):
     text = f"{cfg.width}x{cfg.height} hfov {cfg.hfov:g} clip {cfg.near:g}-{cfg.far:g} m"
     return text + (f" ({renderer})" if renderer else "")

@@ -8,21 +8,21 @@ that link's frame (ODEPhysics rotates the force and the torque about the link's 
 frame); the state's total is their sum. gazebo_ros_bumper publishes these values unchanged: its ``frameName``
 only labels the message (the transformation into it is commented out upstream).
 """
-from typing import List, NamedTuple, Tuple
+from typing import NamedTuple
 
 from diffbot_sim.transforms import quaternion_matrix
 
-Vec3 = Tuple[float, float, float]
+Vec3 = tuple[float, float, float]
 
 
 class ContactState(NamedTuple):
     collision1: str
     collision2: str
-    positions: List[Vec3]
-    normals: List[Vec3]
-    depths: List[float]
-    wrenches: List[Tuple[Vec3, Vec3]]  # (force, torque) on collision1's link, in its frame
-    total: Tuple[Vec3, Vec3]
+    positions: list[Vec3]
+    normals: list[Vec3]
+    depths: list[float]
+    wrenches: list[tuple[Vec3, Vec3]]  # (force, torque) on collision1's link, in its frame
+    total: tuple[Vec3, Vec3]
 
 
 def _cross(a, b):

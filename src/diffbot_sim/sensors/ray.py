@@ -19,7 +19,6 @@ gazebo-classic's ray sensor, sdformat's ``ray.sdf`` and ``noise.sdf``):
 import math
 import zlib
 from dataclasses import dataclass, field
-from typing import List, Tuple
 
 import numpy as np
 
@@ -76,7 +75,7 @@ class Noise:
         return self.type == "gaussian" and (self.mean or self.stddev or self.bias_mean or self.bias_stddev)
 
 
-Pose6 = Tuple[Tuple[float, float, float], Tuple[float, float, float]]
+Pose6 = tuple[tuple[float, float, float], tuple[float, float, float]]
 
 
 @dataclass
@@ -97,7 +96,7 @@ class RayConfig:
     range_max: float = 0.0
     range_resolution: float = 0.0
     noise: Noise = field(default_factory=Noise)
-    warnings: List[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def rays(self):

@@ -17,8 +17,7 @@ import os
 import tempfile
 
 import rospy
-from gazebo_msgs import msg as gmsg
-from gazebo_msgs import srv as gsrv
+from gazebo_msgs import msg as gmsg, srv as gsrv
 from std_srvs.srv import Empty
 
 from diffbot_sim.config import MAX_TIME_STEP, MIN_TIME_STEP
@@ -175,8 +174,10 @@ class GazeboApi:
     # -- ROS side ------------------------------------------------------------------------------------
     def advertise(self):
         ns = self.ns
-        service = lambda name, kind, handler: self.handles.append(  # noqa: E731
-            rospy.Service(f"{ns}/{name}", kind, handler))
+
+        def service(name, kind, handler):
+            self.handles.append(rospy.Service(f"{ns}/{name}", kind, handler))
+
         service("spawn_urdf_model", gsrv.SpawnModel, lambda req: self._spawn(req, "urdf"))
         service("spawn_sdf_model", gsrv.SpawnModel, lambda req: self._spawn(req, "sdf"))
         service("delete_model", gsrv.DeleteModel, self._delete)

@@ -11,12 +11,12 @@ from diffbot_sim.description import meshes
 from diffbot_sim.description.prepared_model import prepare_model, read_model_file
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ModelError
-from diffbot_sim.values import check_number
 from diffbot_sim.physics.robot_loading import place_robot
 from diffbot_sim.plugins import registry
 from diffbot_sim.plugins.base import RobotContext, get_param
 from diffbot_sim.simulator.actors import Actors
 from diffbot_sim.simulator.loop import RobotRuntime, Simulator
+from diffbot_sim.values import check_number
 from diffbot_sim.world.loading import load_world
 
 

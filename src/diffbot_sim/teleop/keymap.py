@@ -8,8 +8,9 @@ Signs follow REP 103 (x forward, positive yaw counter-clockwise): ``i`` drives f
 ``j`` turns left (+angular.z). The seed tutorial had both the other way round.
 """
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
-from typing import Mapping, NamedTuple, Optional
+from typing import NamedTuple
 
 from diffbot_sim.errors import ConfigError
 
@@ -146,7 +147,7 @@ class Teleop:
         # `+ 0.0` turns -0.0 (direction 0 times a speed) into 0.0, so a stop is all zeros.
         return Command(lin * self.speed + 0.0, ang * self.turn + 0.0)
 
-    def press(self, key: str, now: float) -> Optional[Command]:
+    def press(self, key: str, now: float) -> Command | None:
         """Handle one key.
 
         Args:
@@ -172,7 +173,7 @@ class Teleop:
         self._last_key = now
         return self._send(self.command, now)
 
-    def tick(self, now: float) -> Optional[Command]:
+    def tick(self, now: float) -> Command | None:
         """Apply the key timeout and the repeat rate.
 
         Returns:
@@ -193,7 +194,7 @@ class Teleop:
         rate = self.config.repeat_rate
         return rate > 0.0 and self._last_sent is not None and now - self._last_sent >= 1.0 / rate
 
-    def next_deadline(self, now: float) -> Optional[float]:
+    def next_deadline(self, now: float) -> float | None:
         """Seconds from ``now`` until :meth:`tick` may have something to send (None: only a key can).
 
         Lets the node sleep in ``select`` no longer than needed.

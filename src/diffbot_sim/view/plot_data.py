@@ -13,7 +13,6 @@ in the world frame as it is, which equals ``odom`` for the default ``odometry_so
 """
 import math
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -53,8 +52,8 @@ class TfTree:
     50-100 Hz, a scan at 5-10 Hz, so the nearest earlier transform is at most 20 ms old)."""
 
     def __init__(self):
-        self.static: Dict[str, Tuple[str, tuple]] = {}
-        self.dynamic: Dict[str, List[Tuple[float, str, tuple]]] = {}
+        self.static: dict[str, tuple[str, tuple]] = {}
+        self.dynamic: dict[str, list[tuple[float, str, tuple]]] = {}
 
     def add(self, msg, static):
         """Record every transform of a tf2_msgs/TFMessage."""
@@ -119,7 +118,8 @@ def collect(records):
         seen.add(f"{topic} ({kind})")
         if kind == "nav_msgs/Odometry":
             p, q, v = msg.pose.pose.position, msg.pose.pose.orientation, msg.twist.twist
-            row = (msg.header.stamp.to_sec(), p.x, p.y, yaw_from_quaternion(q.x, q.y, q.z, q.w), v.linear.x, v.angular.z)
+            row = (msg.header.stamp.to_sec(), p.x, p.y, yaw_from_quaternion(q.x, q.y, q.z, q.w), v.linear.x,
+                   v.angular.z)
             which = "truth" if msg.header.frame_id.lstrip("/") == "world" else "odom"
             if topics[which] and topics[which] != topic:
                 continue  # a second robot or odometry source: the first one seen is the one drawn
@@ -185,8 +185,8 @@ class Summary:
     samples: int
     duration: float
     distance: float
-    final_error: Optional[float] = None
-    notes: List[str] = field(default_factory=list)
+    final_error: float | None = None
+    notes: list[str] = field(default_factory=list)
 
 
 def summarize(data):

@@ -17,7 +17,6 @@ Display and property names are rviz 1.14's (``src/rviz/default_plugin/*.cpp``).
 """
 import copy
 from dataclasses import dataclass, field
-from typing import List, Tuple
 
 import yaml
 
@@ -48,9 +47,9 @@ class RobotView:
     description: str
     odom_topic: str
     odom_frame: str
-    scans: List[str] = field(default_factory=list)
-    images: List[str] = field(default_factory=list)
-    spawn: Tuple[float, float] = (0.0, 0.0)
+    scans: list[str] = field(default_factory=list)
+    images: list[str] = field(default_factory=list)
+    spawn: tuple[float, float] = (0.0, 0.0)
 
 
 def load_template(path):

@@ -13,7 +13,6 @@ import shutil
 import subprocess
 import time
 from dataclasses import dataclass
-from typing import List
 
 import numpy as np
 
@@ -356,7 +355,7 @@ def color_counts(image, **kw):
     return {name: int(mask.sum()) for name, mask in saturated(image, **kw).items()}
 
 
-__all__: List[str] = ["Xvfb", "XvfbUnavailable", "Window", "parse_tree", "subtree", "list_windows", "find_window",
+__all__: list[str] = ["Xvfb", "XvfbUnavailable", "Window", "parse_tree", "subtree", "list_windows", "find_window",
                       "screenshot", "save_png", "crop", "count_color", "status_colors", "rows_of_color",
                       "changed", "blob", "patch", "greenish", "top_view_pixel", "project", "orbit_camera",
            "pybullet_pixel", "PYBULLET_CAMERA", "PYBULLET_WINDOW", "saturated", "color_counts", "hue", "HUES",

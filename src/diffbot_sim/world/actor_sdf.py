@@ -18,18 +18,17 @@ The script is played by :mod:`diffbot_sim.world.actor_script`; ``libActorPlugin.
 """
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
-from typing import Optional, Tuple
 
 from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.transforms import IGN_EQUAL, quaternion_rpy, rpy_quaternion
 from diffbot_sim.values import check_bool, tag_number
 from diffbot_sim.world.sdf_elements import pose_numbers
 
-Vec3 = Tuple[float, float, float]
-Quat = Tuple[float, float, float, float]
-Pose = Tuple[Vec3, Quat]
+Vec3 = tuple[float, float, float]
+Quat = tuple[float, float, float, float]
+Pose = tuple[Vec3, Quat]
 #: x, y, z (m), roll, pitch, yaw (rad), as SDF writes a ``<pose>``.
-Pose6 = Tuple[float, float, float, float, float, float]
+Pose6 = tuple[float, float, float, float, float, float]
 ZERO_POSE6: Pose6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
@@ -69,7 +68,7 @@ class Trajectory:
     id: int
     type: str
     tension: float = 0.0
-    waypoints: Tuple[Waypoint, ...] = ()
+    waypoints: tuple[Waypoint, ...] = ()
     duration: float = 0.0
 
 
@@ -80,7 +79,7 @@ class Script:
     loop: bool = True
     delay_start: float = 0.0
     auto_start: bool = True
-    trajectories: Tuple[Trajectory, ...] = ()
+    trajectories: tuple[Trajectory, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -99,10 +98,10 @@ class ActorDescription:
 
     name: str
     pose: Pose6 = ZERO_POSE6
-    skin: Optional[Skin] = None
-    animations: Tuple[Animation, ...] = ()
+    skin: Skin | None = None
+    animations: tuple[Animation, ...] = ()
     script: Script = Script()
-    plugins: Tuple[PluginRef, ...] = ()
+    plugins: tuple[PluginRef, ...] = ()
 
     @property
     def world_pose(self) -> Pose:

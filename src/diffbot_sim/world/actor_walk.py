@@ -30,13 +30,12 @@ forever: after :data:`MAX_TARGET_DRAWS` the old target is kept).
 """
 import math
 from dataclasses import dataclass
-from typing import Tuple
 
 from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.transforms import qnormalize, quaternion_rpy, rpy_quaternion, wrap_angle
 from diffbot_sim.values import check_number, tag_number
 
-Vec3 = Tuple[float, float, float]
+Vec3 = tuple[float, float, float]
 
 #: The plugin's file; ``ActorDescription.plugin(PLUGIN_FILENAME)`` finds it.
 PLUGIN_FILENAME = "libActorPlugin.so"
@@ -84,7 +83,7 @@ class WalkerConfig:
     target_weight: float = 1.15
     obstacle_weight: float = 1.5
     animation_factor: float = 4.5
-    ignore_models: Tuple[str, ...] = ()
+    ignore_models: tuple[str, ...] = ()
 
 
 def read_walker_config(description, plugin, path, notes):

@@ -7,11 +7,10 @@ Mesh shapes carry the mesh file's absolute path and its scale; the physics layer
 (:mod:`diffbot_sim.description.meshes`), so COLLADA units are honoured as for robots.
 """
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Tuple
 
-Vec3 = Tuple[float, float, float]
-Quat = Tuple[float, float, float, float]
-Pose = Tuple[Vec3, Quat]
+Vec3 = tuple[float, float, float]
+Quat = tuple[float, float, float, float]
+Pose = tuple[Vec3, Quat]
 IDENTITY: Pose = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
 
@@ -26,13 +25,13 @@ class Shape:
     """
 
     kind: str
-    size: Tuple[float, ...] = ()
+    size: tuple[float, ...] = ()
     pose: Pose = IDENTITY
-    mesh: Optional[str] = None
+    mesh: str | None = None
     scale: Vec3 = (1.0, 1.0, 1.0)
-    vertices: Optional[object] = None  # numpy (N, 3) float for kind trimesh
-    indices: Optional[object] = None  # numpy (M, 3) int for kind trimesh
-    surface: Dict[str, float] = field(default_factory=dict)
+    vertices: object | None = None  # numpy (N, 3) float for kind trimesh
+    indices: object | None = None  # numpy (M, 3) int for kind trimesh
+    surface: dict[str, float] = field(default_factory=dict)
     name: str = ""
 
 
@@ -48,11 +47,11 @@ class Body:
     model: str
     pose: Pose
     static: bool
-    shapes: List[Shape] = field(default_factory=list)
+    shapes: list[Shape] = field(default_factory=list)
     mass: float = 1.0
-    inertia: Tuple[float, float, float, float, float, float] = (1.0, 1.0, 1.0, 0.0, 0.0, 0.0)
+    inertia: tuple[float, float, float, float, float, float] = (1.0, 1.0, 1.0, 0.0, 0.0, 0.0)
     inertial_pose: Pose = IDENTITY
-    color: Optional[Tuple[float, float, float, float]] = None  # rgba of its first <visual>'s material
+    color: tuple[float, float, float, float] | None = None  # rgba of its first <visual>'s material
     model_pose: Pose = IDENTITY  # world pose of its top-level model's frame at start (the /gazebo model pose)
 
     @property
@@ -67,20 +66,21 @@ class WorldDescription:
 
     ``gravity`` m/s^2 (vector); ``real_time_factor``, ``real_time_update_rate``, ``max_step_size`` and
     ``solver_iterations`` from ``<physics>`` (None when the file gives none; ``sdf`` True: a Gazebo world,
-    whose unstated ones are SDF's defaults); ``not_simulated``: lights, scene, GUI camera, plugins, other ``<physics>`` settings,
-    named once at start; ``warnings``: one line each (unknown geometry skipped, missing mesh skipped...).
+    whose unstated ones are SDF's defaults); ``not_simulated``: lights, scene, GUI camera, plugins, other
+    ``<physics>`` settings, named once at start; ``warnings``: one line each (unknown geometry skipped, missing
+    mesh skipped...).
     """
 
     name: str
     source: str
-    bodies: List[Body] = field(default_factory=list)
+    bodies: list[Body] = field(default_factory=list)
     gravity: Vec3 = (0.0, 0.0, -9.8)
-    real_time_factor: Optional[float] = None
-    real_time_update_rate: Optional[float] = None  # Hz of world updates; 0: as fast as possible
-    max_step_size: Optional[float] = None
-    solver_iterations: Optional[int] = None  # <physics><ode><solver><iters>
-    not_simulated: List[str] = field(default_factory=list)
-    warnings: List[str] = field(default_factory=list)
+    real_time_factor: float | None = None
+    real_time_update_rate: float | None = None  # Hz of world updates; 0: as fast as possible
+    max_step_size: float | None = None
+    solver_iterations: int | None = None  # <physics><ode><solver><iters>
+    not_simulated: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
     has_ground: bool = False  # a ground plane is among the bodies (else the simulator adds its own)
-    actors: List[object] = field(default_factory=list)  # world.actor_sdf.ActorDescription, in file order
+    actors: list[object] = field(default_factory=list)  # world.actor_sdf.ActorDescription, in file order
     sdf: bool = False  # an SDF world file (not a map_server map): SDF's <physics> defaults apply

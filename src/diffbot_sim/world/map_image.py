@@ -112,7 +112,7 @@ def read_map(yaml_path, wall_height=1.0, max_boxes=MAX_BOXES_PER_BODY):
 def _read_yaml(yaml_path):
     """The map's metadata, checked, with ``image`` made absolute: (dict, warnings)."""
     try:
-        with open(yaml_path, "r", encoding="utf-8") as stream:
+        with open(yaml_path, encoding="utf-8") as stream:
             doc = yaml.safe_load(stream)
     except OSError as err:
         raise ModelError(f"cannot read the map YAML: {err.strerror or err}", yaml_path) from err

@@ -10,7 +10,6 @@ Left out, each for a reason: planes (infinite; rviz's grid already shows the gro
 move when pushed, and a marker drawn at their start pose would show a box where there is none).
 """
 from dataclasses import dataclass, field
-from typing import Optional, Tuple
 
 import numpy as np
 
@@ -37,11 +36,11 @@ class MarkerSpec:
     (TRIANGLE_LIST: (N, 3) m, three rows per triangle, in the marker's pose frame)."""
 
     kind: str
-    pose: Tuple[Tuple[float, float, float], Tuple[float, float, float, float]]
-    scale: Tuple[float, float, float]
-    color: Tuple[float, float, float, float]
+    pose: tuple[tuple[float, float, float], tuple[float, float, float, float]]
+    scale: tuple[float, float, float]
+    color: tuple[float, float, float, float]
     ns: str
-    mesh: Optional[str] = None
+    mesh: str | None = None
     points: object = field(default_factory=list)  # (N, 3) array or [(x, y, z)]
 
 

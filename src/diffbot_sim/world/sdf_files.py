@@ -180,7 +180,7 @@ class SdfFiles:
                     import rospkg  # lazy, optional: Gazebo itself only searches the model paths
 
                     tried.append(os.path.join(rospkg.RosPack().get_path(package), inner))
-                except Exception:  # noqa: BLE001 - rospkg missing or the package unknown: keep searching
+                except Exception:  # rospkg missing or the package unknown: keep searching
                     pass
         else:
             literal = uri[len("file://"):] if uri.startswith("file://") else uri

@@ -47,7 +47,10 @@ _WORLD_NOT_SIMULATED = ("scene", "gui", "atmosphere", "magnetic_field", "spheric
 def _clean(pose):
     """Plain floats, -0.0 and rounding dust removed, so poses compare and print as the file wrote them."""
     (p, q) = pose
-    tidy = lambda v: 0.0 if abs(v) < 1e-12 else float(v)  # noqa: E731
+
+    def tidy(v):
+        return 0.0 if abs(v) < 1e-12 else float(v)
+
     return (tuple(tidy(v) for v in p), tuple(tidy(v) for v in q))
 
 
