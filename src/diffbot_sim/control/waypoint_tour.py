@@ -25,9 +25,9 @@ class TourConfig:
 class Tour:
     """Where the robot is in its list of waypoints and what it should do now."""
 
-    def __init__(self, waypoints: Sequence[tuple[float, float]], config: TourConfig = TourConfig()):
+    def __init__(self, waypoints: Sequence[tuple[float, float]], config: TourConfig | None = None):
         self.waypoints: list[tuple[float, float]] = [(float(x), float(y)) for x, y in waypoints]
-        self.config = config
+        self.config = config if config is not None else TourConfig()
         self.index = 0
 
     @property

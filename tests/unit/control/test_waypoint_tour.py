@@ -34,3 +34,10 @@ def test_a_simulated_unicycle_completes_a_square():
             break
         x, y, yaw = x + v * math.cos(yaw) * dt, y + v * math.sin(yaw) * dt, yaw + w * dt
     assert tour.done and math.hypot(x, y) < 0.15
+
+
+def test_tours_without_a_config_do_not_share_one():
+    """Each tour gets its own default TourConfig (TourConfig is mutable): tuning one tour leaves the next alone."""
+    first, second = Tour([(1.0, 0.0)]), Tour([(1.0, 0.0)])
+    first.config.speed = 0.05
+    assert second.config.speed == TourConfig().speed
