@@ -135,3 +135,14 @@ def test_ignition_clamp():
 def test_urdf_mimic_target():
     assert urdf_mimic_target(0.5, Mimic("gripper", multiplier=-2.0, offset=0.25)) == pytest.approx(-0.75)
     assert urdf_mimic_target(0.5, Mimic("gripper")) == 0.5
+
+
+def test_effort_is_updates_number_and_state():
+    # the plugin's every-step path (effort) and update give the same efforts from the same PID state
+    by_update = MimicCore(config(hasPID="", maxEffort="5", sensitiveness="0.01"), PidGains(p=10.0, i=1.0, d=0.01))
+    by_effort = MimicCore(config(hasPID="", maxEffort="5", sensitiveness="0.01"), PidGains(p=10.0, i=1.0, d=0.01))
+    for master, mimic in ((0.3, 0.0), (0.3, 0.1), (0.3, 0.295), (1.0, 0.0), (0.2, 0.25), (math.nan, 0.0)):
+        action = by_update.update(master, mimic, 0.001)
+        assert by_effort.effort(master, mimic, 0.001) == (None if action is None else action.value)
+    assert by_effort.effort(0.3, 0.295, 0.001) is None  # within sensitiveness
+    assert by_effort.effort(1.0, 0.0, 0.001) == 5.0  # clamped to maxEffort
