@@ -96,7 +96,8 @@ def expand(data, source, find_package: Callable[[str], str], base_dir: str | Non
     extra = sorted(set(data) - {"scenarios"})
     if extra:
         raise bad(extra[0], "unknown top-level key (only 'scenarios')")
-    runs, seen = [], {}
+    runs: list[Run] = []
+    seen: dict[str, str] = {}
     for index, sc in enumerate(data["scenarios"]):
         where = f"scenarios[{index}]"
         if not isinstance(sc, dict):

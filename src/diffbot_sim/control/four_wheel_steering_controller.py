@@ -48,9 +48,9 @@ class FourWheelSteeringConfig:
     rear_wheels: tuple[str, str]
     front_steerings: tuple[str, str]
     rear_steerings: tuple[str, str]
-    track: float = None
-    wheel_radius: float = None
-    wheel_base: float = None
+    track: float | None = None  # m; None: from the URDF (resolve_geometry)
+    wheel_radius: float | None = None
+    wheel_base: float | None = None
     publish_rate: float = 50.0
     open_loop: bool = False
     velocity_rolling_window_size: int = 10

@@ -19,7 +19,7 @@ position is half the width (MoveIt commands one finger) and it moves (``max_effo
 import math
 from dataclasses import dataclass
 
-from diffbot_sim.control.pid import Pid, pid_gains
+from diffbot_sim.control.pid import Pid, PidGains, pid_gains
 from diffbot_sim.errors import ConfigError
 from diffbot_sim.values import check_number
 
@@ -45,8 +45,8 @@ class GripperConfig:
     gripper_action_speed: float
     resting_threshold: float
     consecutive_samples: int
-    gains1: object  # PidGains of finger1/gains
-    gains2: object
+    gains1: PidGains  # finger1/gains
+    gains2: PidGains
 
 
 def gripper_config(params, name, model_joints):

@@ -25,12 +25,13 @@ _KEEP_TAGS = ("preserveFixedJoint", "disableFixedJointLumping")
 
 
 class GazeboCollision(NamedTuple):
-    """One SDF collision: its name in the Gazebo link ``link``, the URDF link it came from and its index there."""
+    """One SDF collision: its name in the Gazebo link ``link``, the URDF link it came from and its index there
+    (``urdf_index``: ``index`` would hide the tuple's own ``index()`` method)."""
 
     name: str
     link: str
     urdf_link: str
-    index: int
+    urdf_index: int
 
 
 def kept_fixed_joints(model):

@@ -163,7 +163,7 @@ class GoalEnv(gymnasium.Env):
     but the ground) or on leaving the arena; either ends the episode (``terminated``).
     """
 
-    metadata = {"render_modes": []}
+    metadata: dict[str, list[str]] = {"render_modes": []}
 
     def __init__(self, render_mode=None, **kwargs):
         if render_mode is not None:

@@ -136,9 +136,9 @@ class Teleop:
         self.turn = config.turn
         self.quit_requested = False
         self._direction = (0, 0)
-        self._last_key = None     # when the last bound key arrived
-        self._last_sent = None    # when the last command was handed out
-        self._last_command = None
+        self._last_key: float | None = None     # when the last bound key arrived
+        self._last_sent: float | None = None    # when the last command was handed out
+        self._last_command: Command | None = None
 
     @property
     def command(self) -> Command:
@@ -199,7 +199,7 @@ class Teleop:
 
         Lets the node sleep in ``select`` no longer than needed.
         """
-        waits = []
+        waits: list[float] = []
         if self.config.key_timeout > 0.0 and self._direction != (0, 0) and self._last_key is not None:
             waits.append(self._last_key + self.config.key_timeout - now)
         if self.config.repeat_rate > 0.0 and self._last_sent is not None:

@@ -36,7 +36,7 @@ class RunData:
     scan: object = None
     odom_frame: str = "odom"
     truth_frame: str = "world"
-    tf: "TfTree" = None
+    tf: "TfTree | None" = None
     odom_topic: str = ""
     truth_topic: str = ""
 

@@ -22,7 +22,7 @@ def env_model_paths():
 
 #: ROS_PACKAGE_PATH -> its packages' model directories: read once per process, as gazebo_ros reads them once at
 #: start-up (a walk of every package's manifest costs ~30 ms: every spawn_sdf_model paid it).
-_PACKAGE_MODEL_PATHS = {}
+_PACKAGE_MODEL_PATHS: dict[str, list[str]] = {}
 
 
 def ros_package_model_paths(rospack=None):
