@@ -9,8 +9,9 @@ pytest (unit tests, no master) runs first; then each rostest suite in tests/inte
 XML files, never by its console output, which says OK even when a test node crashed.
 Suites whose file name starts with `slow_` run only with --slow (`make test-slow`). Suites whose name starts
 with `nav_` need the navigation stack (`make nav`) and run only with --nav (`make test-nav`): each twice, at
-real time and in fast mode (rostest arg real_time:=false: as fast as the nodes in the loop allow), fast ones one at a time so that their figures are
-the machine's, not a neighbour's; then the shipped navigation batch (examples/batch/nav.yaml, `--jobs 2`).
+real time and in fast mode (rostest arg real_time:=false: as fast as the nodes in the loop allow), fast ones one at
+a time so that their figures are the machine's, not a neighbour's; then the shipped navigation batch
+(examples/batch/nav.yaml, `--jobs 2`).
 Suites whose name starts with `moveit_` need MoveIt (`make moveit`) and run only with --moveit (`make test-moveit`),
 each at real time and in fast mode, one at a time (move_group plans on the cores the simulator runs on).
 """
@@ -354,7 +355,8 @@ def main():
     parser.add_argument("--mode", choices=("real_time", "fast"), default=None,
                         help="--nav, --moveit: only the suites' real-time or fast runs")
     parser.add_argument("--hogs", type=int, default=int(os.environ.get("HOGS", "0")),
-                        help="this many CPU-bound processes beside the rostest suites (a busy machine, e.g. --only view --hogs 2)")
+                        help="this many CPU-bound processes beside the rostest suites (a busy machine, "
+                             "e.g. --only view --hogs 2)")
     args = parser.parse_args()
     if args.nav:
         return run_nav(args)
