@@ -16,6 +16,9 @@ mathematics they need, for diffbot_arm (urdf/diffbot_arm.urdf.xacro) in worlds/p
 * :func:`gripper_outcome`: whether a gripper step did what it was for: an opening reached its goal; a closing
   *stalled on the object* (upstream's GripperActionController ends ABORTED with ``stalled`` when the fingers
   stop on something) with the fingers apart by about the object's width, not closed on nothing.
+* For the MoveIt variant (``pick_place --moveit``): :data:`TABLES`, the world's tables as collision objects;
+  :func:`top_down_pose`, the tool pose a 4-joint arm can take above a point (fingers down, turned towards it);
+  :func:`moveit_steps`, the same sequence with the arm's steps as tool poses and the gripper's as finger targets.
 
 Units: m, rad, s, N. Frames: the world's (z up); the base pose is base_footprint's (x, y, yaw).
 """
@@ -279,6 +282,64 @@ def describe(steps: Sequence[Step]):
     """One line per step (for the log)."""
     lines = []
     for index, step in enumerate(steps, 1):
-        target = ", ".join(f"{v:.3f}" for v in step.target)
+        target = ", ".join(v if isinstance(v, str) else f"{v:.3f}" for v in step.target)
         lines.append(f"{index:2d}. {step.name} ({step.kind}: {target})")
     return lines
+
+
+#: The tables of worlds/pick_place.world as MoveIt collision boxes: (name, centre (x, y, z) [m], size (x, y, z) [m]).
+#: Each is the solid block from the floor to its top surface (z 0.12): the arm never reaches under a table.
+TABLES = (("pick_table", (0.75, 0.0, 0.06), (0.30, 0.40, 0.12)),
+          ("place_table", (-0.75, 0.0, 0.06), (0.30, 0.40, 0.12)))
+
+
+def top_down_pose(point, shoulder):
+    """(x, y, z, qx, qy, qz, qw): gripper_tcp_link at ``point`` (x, y, z) with the fingers pointing straight down,
+    turned about the vertical towards ``point`` from ``shoulder`` (x, y), the shoulder yaw axis: the orientation
+    a 4-joint arm (yaw, then three pitch joints) has there, so that a 6-D pose goal is one it can reach.
+    The rotation is Rz(yaw) Ry(pi)."""
+    yaw = math.atan2(point[1] - shoulder[1], point[0] - shoulder[0])
+    s, c = math.sin(yaw / 2.0), math.cos(yaw / 2.0)
+    return (float(point[0]), float(point[1]), float(point[2]), -s, c, 0.0, 0.0)
+
+
+def shoulder_xy(arm: ArmGeometry, x, y, yaw):
+    """(x, y) of the shoulder yaw axis for the base at (x, y, yaw)."""
+    return x + arm.shoulder_x * math.cos(yaw), y + arm.shoulder_x * math.sin(yaw)
+
+
+#: MoveIt step kinds: the arm to a tool pose (target: a :func:`top_down_pose` point, z [m]), the arm to a named
+#: pose of the SRDF (target: (name,)), the gripper to a left_finger_joint position (target: (position,)).
+POSE, NAMED, FINGERS = "pose", "named", "fingers"
+
+
+def moveit_steps(scene: Scene, start=(0.0, 0.0, 0.0)):
+    """The pick-and-place of :func:`plan` for MoveIt: the same base motions; the arm's steps as tool points above
+    the object (POSE: target (x, y, z) in the world; the caller turns it into :func:`top_down_pose` from where the
+    base is then), the gripper's as finger positions (FINGERS), home as the SRDF's named pose (NAMED)."""
+    grasp = (scene.pick[0], scene.pick[1], scene.pick[2] + scene.grasp_above)
+    place = (scene.place[0], scene.place[1], scene.place[2] + scene.grasp_above)
+    pick_base = _ahead(scene.pick, scene.pick_heading + math.pi, scene.standoff)
+    place_base = _ahead(scene.place, scene.place_heading + math.pi, scene.standoff)
+    pick_clear = _ahead(pick_base, scene.pick_heading + math.pi, scene.back_off)
+
+    def above(point, lift):
+        return (point[0], point[1], point[2] + lift)
+    steps = [Step("open the gripper", FINGERS, (scene.open_width,), expect=OPEN)]
+    steps += _travel(start, pick_base, scene.pick_heading, "the pick table")
+    steps += [
+        Step("pregrasp above the object", POSE, above(grasp, scene.pregrasp_lift)),
+        Step("lower onto the object", POSE, grasp),
+        Step("close on the object", FINGERS, (scene.close_command,), expect=HOLD),
+        Step("lift the object", POSE, above(grasp, scene.carry_lift)),
+        Step("back away from the pick table", DRIVE, (pick_clear[0], pick_clear[1], -1.0)),
+    ]
+    steps += _travel(pick_clear, place_base, scene.place_heading, "the place table")
+    steps += [
+        Step("above the place point", POSE, above(place, scene.pregrasp_lift)),
+        Step("lower onto the place table", POSE, place),
+        Step("release the object", FINGERS, (scene.open_width,), expect=OPEN),
+        Step("retract above the object", POSE, above(place, scene.pregrasp_lift)),
+        Step("home", NAMED, ("home",)),
+    ]
+    return steps

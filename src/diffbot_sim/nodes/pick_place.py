@@ -13,6 +13,9 @@ drive plugin with ``odometrySource world``, the seed's).
 
 Exit status: 0 when every step succeeded, 1 when one failed (the step and why in one line) or a parameter is
 bad; the base is stopped either way.
+
+``--moveit`` (or ``_moveit:=true``): the arm and the gripper planned and executed by MoveIt instead
+(:mod:`diffbot_sim.nodes.pick_place_moveit`; ``roslaunch diffbot_arm_moveit_config demo_gazebo.launch``).
 """
 import sys
 import threading
@@ -174,6 +177,11 @@ def scene_from_params():
 def main(argv=None):
     """Entry point of ``rosrun diffbot_sim pick_place``; returns the exit status."""
     rospy.init_node("pick_place")
+    args = rospy.myargv(sys.argv if argv is None else argv)
+    if "--moveit" in args[1:] or rospy.get_param("~moveit", False) is True:
+        from diffbot_sim.nodes import pick_place_moveit
+
+        return pick_place_moveit.run(Robot, StepFailed, scene_from_params)
     try:
         step_timeout = check_number("~step_timeout", rospy.get_param("~step_timeout", 20.0), low=0.0, low_open=True)
         scene = scene_from_params()

@@ -166,3 +166,55 @@ def test_describe_lists_every_step():
     steps = pp.plan(pp.Scene(), ARM)
     lines = pp.describe(steps)
     assert len(lines) == len(steps) and lines[0].startswith(" 1. open the gripper")
+
+
+def _rotate(q, v):
+    x, y, z, w = q
+    # v' = q v q*, written out for a unit quaternion
+    tx, ty, tz = 2 * (y * v[2] - z * v[1]), 2 * (z * v[0] - x * v[2]), 2 * (x * v[1] - y * v[0])
+    return (v[0] + w * tx + y * tz - z * ty, v[1] + w * ty + z * tx - x * tz, v[2] + w * tz + x * ty - y * tx)
+
+
+@pytest.mark.parametrize("point, shoulder", [((0.64, 0.0, 0.15), (0.45, 0.0)), ((-0.5, 0.3, 0.2), (-0.3, 0.0)),
+                                             ((0.1, -0.4, 0.3), (0.0, 0.0))])
+def test_top_down_pose_points_the_fingers_down_and_faces_the_point(point, shoulder):
+    x, y, z, *q = pp.top_down_pose(point, shoulder)
+    assert (x, y, z) == point
+    assert math.isclose(sum(c * c for c in q), 1.0)
+    down = _rotate(q, (0.0, 0.0, 1.0))  # the tool's z axis, along the fingers
+    assert down == pytest.approx((0.0, 0.0, -1.0), abs=1e-9)
+    forward = _rotate(q, (1.0, 0.0, 0.0))  # Rz(yaw) Ry(pi) turns x to (-cos yaw, -sin yaw, 0)
+    yaw = math.atan2(point[1] - shoulder[1], point[0] - shoulder[0])
+    assert forward == pytest.approx((-math.cos(yaw), -math.sin(yaw), 0.0), abs=1e-9)
+
+
+def test_shoulder_xy_follows_the_base():
+    arm = pp.ArmGeometry(-0.03, 0.2, 0.14, 0.12, 0.0675)
+    assert pp.shoulder_xy(arm, 1.0, 2.0, 0.0) == pytest.approx((0.97, 2.0))
+    assert pp.shoulder_xy(arm, 1.0, 2.0, math.pi / 2) == pytest.approx((1.0, 1.97))
+
+
+def test_moveit_steps_pick_above_the_object_and_place_on_the_other_table():
+    scene = pp.Scene()
+    steps = pp.moveit_steps(scene)
+    kinds = [s.kind for s in steps]
+    assert kinds[0] == pp.FINGERS and steps[0].expect == pp.OPEN
+    assert steps[-1] == pp.Step("home", pp.NAMED, ("home",))
+    poses = [s for s in steps if s.kind == pp.POSE]
+    grasp = next(s for s in poses if s.name == "lower onto the object")
+    assert grasp.target == pytest.approx((scene.pick[0], scene.pick[1], scene.pick[2] + scene.grasp_above))
+    place = next(s for s in poses if s.name == "lower onto the place table")
+    assert place.target == pytest.approx((scene.place[0], scene.place[1], scene.place[2] + scene.grasp_above))
+    hold = next(s for s in steps if s.expect == pp.HOLD)
+    assert kinds.index(pp.FINGERS, 1) == steps.index(hold)
+    # the base motions are the plain variant's
+    arm = pp.ArmGeometry(-0.03, 0.216, 0.14, 0.12, 0.0675)
+    plain = [s for s in pp.plan(scene, arm) if s.kind in (pp.DRIVE, pp.TURN)]
+    assert [s for s in steps if s.kind in (pp.DRIVE, pp.TURN)] == plain
+    assert all(line for line in pp.describe(steps))
+
+
+def test_tables_cover_the_worlds_table_tops():
+    for _, centre, size in pp.TABLES:
+        assert centre[2] + size[2] / 2 == pytest.approx(0.12)  # the top surface of both tables
+    assert {name for name, _, _ in pp.TABLES} == {"pick_table", "place_table"}
