@@ -7,12 +7,13 @@ import math
 import re
 import warnings
 from dataclasses import dataclass
-from typing import Optional
 
 import rospy
 
-from diffbot_sim.config import prefix_frame
-from diffbot_sim.control.schedule import first_due_model, first_due_sensor, next_due  # noqa: F401 (for plugins)
+from diffbot_sim.config import RobotSpec, SimConfig, prefix_frame
+from diffbot_sim.control.schedule import first_due_model, first_due_sensor, next_due
+from diffbot_sim.description.urdf_model import RobotModel
+from diffbot_sim.plugins.interfaces import PluginRobot, PluginSimulator
 
 
 def publisher(name, msg_class):
@@ -86,20 +87,22 @@ class RobotContext:
     """One robot as its plugins see it.
 
     Attributes:
-        sim: the Simulator: ``warn(key, text)`` (throttled), ``wake`` (an Event a callback sets).
-        cfg: the SimConfig. spec: the RobotSpec. model: the RobotModel. robot: the physics Robot.
+        sim: the Simulator, as much of it as plugins may use (:class:`~diffbot_sim.plugins.interfaces.
+            PluginSimulator`): sim time, the world, ``warn``, ``post``/``call`` and ``wake`` for callbacks.
+        cfg: the SimConfig. spec: the RobotSpec. model: the RobotModel.
+        robot: the physics Robot (:class:`~diffbot_sim.plugins.interfaces.PluginRobot`: what plugins use of it).
         params: the node's private parameters (a dict, read once).
         namespace: ``/<name>`` for a named robot of ``~robots`` (it replaces every plugin's own), else None.
         private: prefix of this robot's private topics (``~`` or ``~<name>/``).
     """
 
-    sim: object
-    cfg: object
-    spec: object
-    model: object
-    robot: object
+    sim: PluginSimulator
+    cfg: SimConfig
+    spec: RobotSpec
+    model: RobotModel
+    robot: PluginRobot
     params: dict
-    namespace: Optional[str]
+    namespace: str | None
     private: str
 
     @property
@@ -173,6 +176,9 @@ def close_handle(handle):
 class Plugin:
     """What the loop calls. Times are sim seconds; ``stamp`` is the same time as a rospy.Time."""
 
+    #: The robot's context, which each plugin keeps as ``self.ctx`` (declared here so that mypy checks what
+    #: plugins do with it against RobotContext's types).
+    ctx: RobotContext
     #: The plugin's filename (or a descriptive name for built-in ones), for reports.
     filename = ""
     #: Its publications are sensor data that nodes in the loop answer (``~wait_for_nodes`` waits after them).

@@ -4,6 +4,8 @@
 
 A model is read and placed as the Gymnasium scene reads and places it: :mod:`diffbot_sim.description.prepared_model`
 and :mod:`diffbot_sim.physics.robot_loading`."""
+from typing import TYPE_CHECKING
+
 import rospy
 
 from diffbot_sim import config as cfgmod
@@ -18,6 +20,13 @@ from diffbot_sim.simulator.actors import Actors
 from diffbot_sim.simulator.loop import RobotRuntime, Simulator
 from diffbot_sim.values import check_number
 from diffbot_sim.world.loading import load_world
+
+if TYPE_CHECKING:
+    from diffbot_sim.plugins.interfaces import PluginSimulator
+
+    def _simulator_conforms(sim: Simulator) -> PluginSimulator:
+        """For mypy alone: the Simulator gives its robots' plugins what PluginSimulator promises them."""
+        return sim
 
 
 def _load_model(spec):
