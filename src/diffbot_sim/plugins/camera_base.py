@@ -19,7 +19,7 @@ class CameraBase(Plugin):
 
     def __init__(self, ctx, sensor, cfg, tags):
         self.ctx = ctx
-        self.sensor = sensor
+        self.sdf_sensor = sensor  # (``sensor`` is Plugin's flag: its publications are sensor data)
         self.cfg = cfg
         self.tags = tags
         self.link = sensor.link or ctx.model.root
@@ -57,10 +57,10 @@ class CameraBase(Plugin):
     def _frame_name(self):
         frame = self.tags.values.get("frame")
         if frame:
-            return self.ctx.clean_frame(frame, f"{self.sensor.path}/plugin frameName")
+            return self.ctx.clean_frame(frame, f"{self.sdf_sensor.path}/plugin frameName")
         if self.tags.dialect == "ros2":
             return self.link
-        self.ctx.warnings.append(f"{self.sensor.path}: no frameName; images are in 'world' (Gazebo: '/world')")
+        self.ctx.warnings.append(f"{self.sdf_sensor.path}: no frameName; images are in 'world' (Gazebo: '/world')")
         return "world"
 
     def namespace(self):

@@ -139,8 +139,8 @@ class Gps(Plugin):
         velocity = [m(x, dt) for m, x in zip(self.v["velocity"], velocity)]
         for p, vm in zip(self.v["position"], self.v["velocity"]):
             p.current_drift += dt * vm.current_drift  # a velocity bias walks the position, as hector
-        position = [m(x, dt) for m, x in zip(self.v["position"], position)]
-        lat, lon, alt = to_geodetic(position, self.v["reference"])
+        measured = [m(x, dt) for m, x in zip(self.v["position"], position)]
+        lat, lon, alt = to_geodetic(measured, self.v["reference"])
         if self.fix_pub.get_num_connections():
             self.fix_pub.publish(ros_msgs.nav_sat_fix(stamp, self.frame_id, lat, lon, alt, self.covariance,
                                                       self.v["status"], self.v["service"]))

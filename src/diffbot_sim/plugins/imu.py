@@ -129,11 +129,14 @@ class ImuSettings:
         self.initial_reference = False
         self.sdf_rate = [None] * 3
         self.sdf_accel = [None] * 3
-        self.covariance = (0.0, 0.0, 0.0)
+        # orientation, angular velocity, linear acceleration: each one variance, or three (one per axis)
+        self.covariance: tuple = (0.0, 0.0, 0.0)
         self.service = None
         self.hector = None  # {"accel": [3 models], "rate": [...], "yaw": [1 model]}
         self.bias_topic = None
         self.mount = None  # SDF sensor <pose> in the link
+        self.unknown: list[str] = []  # a warning per tag the plugin does not know
+        self.generator = None  # the noise models' random generator
         self.__dict__.update(values)
 
 

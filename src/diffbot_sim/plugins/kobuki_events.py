@@ -29,9 +29,10 @@ class CliffSensor:
 
     def range(self):
         cfg = self.cfg
-        origin = ray_sensor.sensor_pose(*self.ctx.robot.link_pose(self.link), self.pose)
-        fractions, _, _ = self.ctx.sim.world.ray_batch(*ray_sensor.world_rays(*origin, self.directions,
-                                                                               cfg.range_min, cfg.range_max))
+        link_position, link_quaternion = self.ctx.robot.link_pose(self.link)
+        position, rotation = ray_sensor.sensor_pose(link_position, link_quaternion, self.pose)
+        starts, ends = ray_sensor.world_rays(position, rotation, self.directions, cfg.range_min, cfg.range_max)
+        fractions, _, _ = self.ctx.sim.world.ray_batch(starts, ends)
         return float(ray_sensor.raw_ranges(fractions, cfg.range_min, cfg.range_max)[0])
 
 
