@@ -49,13 +49,13 @@ class Laser(ray_base.RaySensorPlugin):
         h = cfg.horizontal
         self.middle_row = filename == ROS2_RAY and cfg.vertical.count > 1
         if output == "sensor_msgs/LaserScan":
-            self.builder = ros_msgs.LaserScanBuilder(frame, h.min_angle, h.max_angle, h.increment, cfg.range_min,
-                                                     cfg.range_max)
+            self.scan_builder = ros_msgs.LaserScanBuilder(frame, h.min_angle, h.max_angle, h.increment,
+                                                          cfg.range_min, cfg.range_max)
         elif output == "sensor_msgs/PointCloud2":
-            self.builder = ros_msgs.PointCloud2Builder(frame)
+            self.cloud_builder = ros_msgs.PointCloud2Builder(frame)
         elif output == "sensor_msgs/Range":
             fov = max(h.max_angle - h.min_angle, cfg.vertical.max_angle - cfg.vertical.min_angle)
-            self.builder = ros_msgs.RangeBuilder(frame, ultrasound, fov, cfg.range_min, cfg.range_max)
+            self.range_builder = ros_msgs.RangeBuilder(frame, ultrasound, fov, cfg.range_min, cfg.range_max)
 
     def publish(self, now, stamp):
         fractions, retro = self.cast()
@@ -67,13 +67,13 @@ class Laser(ray_base.RaySensorPlugin):
                 count = self.cfg.horizontal.count
                 start = (self.cfg.vertical.count // 2) * count
                 ranges, intensities = ranges[start:start + count], intensities[start:start + count]
-            msg = self.builder.build(stamp, ranges, intensities)
+            msg = self.scan_builder.build(stamp, ranges, intensities)
         elif self.output == "sensor_msgs/Range":
-            msg = self.builder.build(stamp, float(ranges.min()))
+            msg = self.range_builder.build(stamp, float(ranges.min()))
         else:
             points = ray_sensor.scan_points(ranges, intensities, self.cfg, self.min_intensity)
             if self.output == "sensor_msgs/PointCloud2":
-                msg = self.builder.build(stamp, points)
+                msg = self.cloud_builder.build(stamp, points)
             else:
                 msg = ros_msgs.point_cloud(stamp, self.frame, points)
         self.pub.publish(msg)
