@@ -39,8 +39,9 @@ collide mode "none" / "all" with ``disable_collisions_on_attach``) are the calle
 import collections.abc
 import math
 import xml.etree.ElementTree as ET
+from collections.abc import Hashable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Dict, Hashable, List, Mapping, NamedTuple, Optional, Sequence, Tuple
+from typing import NamedTuple
 
 from diffbot_sim.errors import PluginNotLoaded
 from diffbot_sim.transforms import qconj, rotate
@@ -52,8 +53,8 @@ LENGTH_RATIO = 0.3
 #: CheckGrip ignores force vectors shorter than this (N).
 MIN_FORCE = 1e-4
 
-Vec3 = Tuple[float, float, float]
-Pose = Tuple[Vec3, Tuple[float, float, float, float]]  # ((x, y, z), (qx, qy, qz, qw)), world frame
+Vec3 = tuple[float, float, float]
+Pose = tuple[Vec3, tuple[float, float, float, float]]  # ((x, y, z), (qx, qy, qz, qw)), world frame
 
 
 @dataclass(frozen=True)
@@ -62,7 +63,7 @@ class GraspArm:
 
     name: str
     palm_link: str
-    gripper_links: Tuple[str, ...]
+    gripper_links: tuple[str, ...]
 
 
 @dataclass(frozen=True)
@@ -71,14 +72,14 @@ class GraspFixConfig:
     ``release_tolerance`` in m; ``notes`` are ready-to-log lines (skipped arms, odd values)."""
 
     path: str
-    arms: Tuple[GraspArm, ...]
+    arms: tuple[GraspArm, ...]
     forces_angle_tolerance: float = math.radians(120.0)
     update_rate: int = 5
     max_grip_count: int = 10
     grip_count_threshold: int = 5
     release_tolerance: float = 0.005
     disable_collisions_on_attach: bool = False
-    notes: Tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
 
     @property
     def update_period(self):
@@ -103,7 +104,7 @@ def _text(item):
     return "" if item is None else str(item).strip()
 
 
-def grasp_fix_config(plugin, path, link_collisions: Optional[Mapping[str, int]] = None) -> GraspFixConfig:
+def grasp_fix_config(plugin, path, link_collisions: Mapping[str, int] | None = None) -> GraspFixConfig:
     """Read a gazebo_grasp_fix ``<plugin>``.
 
     Args:
@@ -117,7 +118,7 @@ def grasp_fix_config(plugin, path, link_collisions: Optional[Mapping[str, int]] 
         PluginNotLoaded: no ``<arm>``, or no arm usable (the notes on the skipped arms are in the message).
         ConfigError: a number tag without a leading number, or ``update_rate`` < 1.
     """
-    notes = []
+    notes: list[str] = []
 
     def number(tag, default, integer=False, **limits):
         items = _children(plugin, tag)
@@ -157,8 +158,8 @@ def _read_arms(plugin, path, link_collisions, notes):
     if not declared:
         raise PluginNotLoaded("GazeboGraspFix: Cannot load the GazeboGraspFix without any <arm> declarations",
                               element=path)
-    arms: Dict[str, GraspArm] = {}
-    claimed: Dict[str, str] = {}  # gripper link -> the first arm that listed it
+    arms: dict[str, GraspArm] = {}
+    claimed: dict[str, str] = {}  # gripper link -> the first arm that listed it
     arm_notes_start = len(notes)
     for index, arm in enumerate(declared, 1):
         where = f"{path}/arm[{index}]"
@@ -286,17 +287,17 @@ class GraspFixCore:
 
     def __init__(self, config: GraspFixConfig):
         self.config = config
-        self._arm_of_link: Dict[str, str] = {}
+        self._arm_of_link: dict[str, str] = {}
         for arm in config.arms:
             for link in arm.gripper_links:
                 self._arm_of_link.setdefault(link, arm.name)
         self._arms = {arm.name: arm for arm in config.arms}
-        self.grip_counts: Dict[Hashable, int] = {}
-        self.attached: Dict[str, Hashable] = {}  # arm -> object
-        self._attach_points: Dict[Hashable, Dict[str, Tuple[Vec3, Vec3]]] = {}
+        self.grip_counts: dict[Hashable, int] = {}
+        self.attached: dict[str, Hashable] = {}  # arm -> object
+        self._attach_points: dict[Hashable, dict[str, tuple[Vec3, Vec3]]] = {}
 
-    def update(self, contacts: Sequence[GraspContact], link_poses: Optional[Mapping[str, Pose]] = None,
-               object_positions: Optional[Mapping[Hashable, Vec3]] = None) -> List[tuple]:
+    def update(self, contacts: Sequence[GraspContact], link_poses: Mapping[str, Pose] | None = None,
+               object_positions: Mapping[Hashable, Vec3] | None = None) -> list[tuple]:
         """One ``OnUpdate``.
 
         Args:
@@ -330,7 +331,7 @@ class GraspFixCore:
 
     def _average(self, contacts):
         """{object: {link: _LinkContact}} of the gripper-link contacts."""
-        sums: Dict[Hashable, Dict[str, list]] = {}
+        sums: dict[Hashable, dict[str, list]] = {}
         for contact in contacts:
             arm = self._arm_of_link.get(contact.link)
             if arm is None:
@@ -345,7 +346,7 @@ class GraspFixCore:
 
     def _attach(self, obj, links):
         """Attach ``obj`` to the arm with the most links touching it, unless an involved arm holds an object."""
-        involved: Dict[str, int] = {}
+        involved: dict[str, int] = {}
         best, best_count = None, 0
         for link in sorted(links):
             arm = links[link].arm

@@ -23,7 +23,8 @@ caller's symmetry); ``query_state``'s ``time`` is the requested sample time.
 """
 import bisect
 import math
-from typing import Hashable, NamedTuple, Optional, Tuple
+from collections.abc import Hashable
+from typing import NamedTuple
 
 from diffbot_sim.control.joint_trajectory_config import JtcConfig
 from diffbot_sim.control.pid import Pid
@@ -67,9 +68,9 @@ class TrajectoryState(NamedTuple):
     them); ``time_from_start`` is in s.
     """
 
-    positions: Tuple[float, ...]
-    velocities: Tuple[float, ...]
-    accelerations: Tuple[float, ...]
+    positions: tuple[float, ...]
+    velocities: tuple[float, ...]
+    accelerations: tuple[float, ...]
     time_from_start: float
 
 
@@ -92,13 +93,13 @@ class JtcUpdate(NamedTuple):
     says whether to publish ``state`` now.
     """
 
-    commands: Optional[Tuple[float, ...]]
+    commands: tuple[float, ...] | None
     desired: TrajectoryState
     actual: TrajectoryState
     error: TrajectoryState
-    events: Tuple[GoalEvent, ...]
+    events: tuple[GoalEvent, ...]
     state_due: bool
-    feedback_goal_id: Optional[Hashable]
+    feedback_goal_id: Hashable | None
 
 
 class GoalAnswer(NamedTuple):
@@ -109,7 +110,7 @@ class GoalAnswer(NamedTuple):
     accepted: bool
     error_code: int
     error_string: str
-    preempted_goal_id: Optional[Hashable] = None
+    preempted_goal_id: Hashable | None = None
 
 
 class JointTrajectoryControllerCore:
@@ -130,11 +131,11 @@ class JointTrajectoryControllerCore:
         self._zeros = (0.0,) * n
         self._state_period_ns = to_ns(1.0 / cfg.state_publish_rate) if cfg.state_publish_rate else None
         self._active_goal = None
-        self._done = set()  # joints inside the goal tolerance; upstream's successful_joint_traj_
+        self._done: set[str] = set()  # joints inside the goal tolerance; upstream's successful_joint_traj_
         self._desired = ([0.0] * n, [0.0] * n, [0.0] * n)
         self._measured = ([0.0] * n, [0.0] * n)
         self._last_state_publish_ns = 0
-        self._pending = []  # goals preempted by a topic command, reported by the next update
+        self._pending: list[GoalEvent] = []  # goals preempted by a topic command, reported by the next update
         self._log = list(cfg.log)
 
     def _set_trajectory(self, trajectory):

@@ -28,8 +28,9 @@ shared by every instance); the caller passes it. :func:`urdf_mimic_target` is fo
 drives: ``robot_state_publisher`` computes their TF the same way when they are absent from /joint_states.
 """
 import xml.etree.ElementTree as ET
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Callable, Mapping, NamedTuple, Optional, Tuple, Union
+from typing import NamedTuple
 
 from diffbot_sim.control.pid import Pid, PidGains
 from diffbot_sim.errors import ConfigError, PluginNotLoaded
@@ -57,9 +58,9 @@ class MimicConfig:
     sensitiveness: float = 0.0
     max_effort: float = -1.0
     has_pid: bool = False
-    pid_namespace: Optional[str] = None
+    pid_namespace: str | None = None
     robot_namespace: str = ""
-    notes: Tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
 
 
 class MimicAction(NamedTuple):
@@ -90,7 +91,7 @@ def _resolve_namespace(robot_namespace, name):
     return "/" + "/".join(parts)
 
 
-def mimic_config(tags: Union[Mapping[str, str], ET.Element], path: str,
+def mimic_config(tags: Mapping[str, str] | ET.Element, path: str,
                  effort_limit_of: Callable[[str], float]) -> MimicConfig:
     """Read one MimicJointPlugin's tags.
 
@@ -107,7 +108,7 @@ def mimic_config(tags: Union[Mapping[str, str], ET.Element], path: str,
         ConfigError: a number tag without a leading number, or a ``~`` PID namespace (roscpp throws).
     """
     texts = _tag_texts(tags)
-    notes = []
+    notes: list[str] = []
     robot_namespace = texts.get("robotNamespace", "")
     if "joint" not in texts:
         raise PluginNotLoaded("No joint element present. MimicJointPlugin could not be loaded.", element=path)
@@ -158,7 +159,7 @@ class MimicCore:
             PID. Ignored without ``<hasPID>``.
     """
 
-    def __init__(self, config: MimicConfig, gains: Optional[PidGains] = None):
+    def __init__(self, config: MimicConfig, gains: PidGains | None = None):
         self.config = config
         self._pid = Pid(gains or PidGains(p=0.0)) if config.has_pid else None
 
@@ -166,7 +167,7 @@ class MimicCore:
         """Where the mimic joint should be: ``master * multiplier + offset`` (rad or m)."""
         return master_position * self.config.multiplier + self.config.offset
 
-    def update(self, master_position, mimic_position, dt) -> Optional[MimicAction]:
+    def update(self, master_position, mimic_position, dt) -> MimicAction | None:
         """This step's action on the mimic joint, or None while within ``sensitiveness`` (or a position is NaN).
 
         Args:
@@ -180,7 +181,7 @@ class MimicCore:
             return None
         return MimicAction("position", target)
 
-    def effort(self, master_position, mimic_position, dt) -> Optional[float]:
+    def effort(self, master_position, mimic_position, dt) -> float | None:
         """With ``<hasPID>``: :meth:`update`'s effort (N·m or N) as a number, or None when it does nothing (the
         plugin's every step, without building an action)."""
         config = self.config

@@ -23,8 +23,9 @@ mathematics they need, for diffbot_arm (urdf/diffbot_arm.urdf.xacro) in worlds/p
 Units: m, rad, s, N. Frames: the world's (z up); the base pose is base_footprint's (x, y, yaw).
 """
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import NamedTuple, Optional, Sequence, Tuple
+from typing import NamedTuple
 
 from diffbot_sim.errors import ConfigError
 from diffbot_sim.transforms import wrap_angle
@@ -109,8 +110,8 @@ class Scene:
     table); ``pick_heading`` / ``place_heading`` [rad]: the way the base faces each table (towards it).
     """
 
-    pick: Tuple[float, float, float] = (0.64, 0.0, 0.1425)
-    place: Tuple[float, float, float] = (-0.64, 0.0, 0.1425)
+    pick: tuple[float, float, float] = (0.64, 0.0, 0.1425)
+    place: tuple[float, float, float] = (-0.64, 0.0, 0.1425)
     pick_heading: float = 0.0
     place_heading: float = math.pi
     object_size: float = 0.045  # m across (the fingers close on it)
@@ -255,7 +256,7 @@ def still_there(step: Step, x, y, yaw, config: MotionConfig = MotionConfig()):
     return motion.done
 
 
-def gripper_outcome(step: Step, status: str, position: Optional[float], reached_goal: bool, stalled: bool,
+def gripper_outcome(step: Step, status: str, position: float | None, reached_goal: bool, stalled: bool,
                     object_size: float, tolerance: float = 0.008):
     """(ok, reason) for a GRIPPER step's result: ``status`` "SUCCEEDED" / "ABORTED" / other, the result's
     ``position`` [m] (one finger's, so half the opening), ``reached_goal`` and ``stalled``.

@@ -21,7 +21,6 @@ negated) and ``initXml``.
 """
 import math
 from dataclasses import dataclass
-from typing import Optional
 
 from diffbot_sim.errors import ConfigError
 from diffbot_sim.values import check_bool, check_number
@@ -67,7 +66,7 @@ def _namespace_dict(params, name):
     return params
 
 
-def pid_gains(params, name) -> Optional[PidGains]:
+def pid_gains(params, name) -> PidGains | None:
     """The gains in the rosparam dict ``params`` of the PID namespace ``name`` (e.g.
     ``/gazebo_ros_control/pid_gains/joint1``), read as ``Pid::init`` reads them.
 

@@ -24,8 +24,9 @@ tolerances checked while that goal is active.
 import bisect
 import dataclasses
 import math
+from collections.abc import Hashable, Sequence
 from dataclasses import dataclass
-from typing import Hashable, NamedTuple, Optional, Sequence, Tuple
+from typing import NamedTuple
 
 from diffbot_sim.control.angles import shortest_angular_distance
 
@@ -112,8 +113,8 @@ class SplineState:
     """A segment end point; velocity/acceleration None when the point does not give them."""
 
     position: float
-    velocity: Optional[float] = None
-    acceleration: Optional[float] = None
+    velocity: float | None = None
+    acceleration: float | None = None
     time_from_start: float = 0.0
 
 
@@ -160,9 +161,9 @@ class Segment:
 
     start_time: float
     duration: float
-    coefficients: Tuple[float, ...]
+    coefficients: tuple[float, ...]
     time_from_start: float = 0.0
-    owner: Optional[Hashable] = None
+    owner: Hashable | None = None
     tolerances: SegmentTolerances = NO_TOLERANCES
 
     @classmethod
@@ -326,7 +327,7 @@ class MergeResult(NamedTuple):
     """The trajectory to execute, and upstream's ROS_WARN about dropped points (None if silent)."""
 
     trajectory: tuple
-    warning: Optional[str]
+    warning: str | None
 
 
 def merge_trajectory(current, joint_names, wraparound, message_joints, points, stamp_ns, now_ns, now_uptime_ns,

@@ -85,7 +85,7 @@ class UrdfMimic(Plugin):
     def before_step(self, now):
         robot = self.ctx.robot
         masters = robot.joint_positions([m for m, _, _ in self.couplings])
-        for (master, mimic, spec), position in zip(self.couplings, masters):
+        for (_master, mimic, spec), position in zip(self.couplings, masters):
             robot.set_positions([mimic], [urdf_mimic_target(position, spec)], [UNLIMITED_EFFORT],
                                 KINEMATIC_POSITION_GAIN)
 

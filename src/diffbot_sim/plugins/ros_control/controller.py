@@ -17,7 +17,7 @@ class Controller:
     """
 
     type = ""
-    interface = None
+    interface: str | None = None
 
     def __init__(self, ctx, hw, name, params):
         self.ctx, self.hw, self.name = ctx, hw, name

@@ -14,8 +14,7 @@ from nav_msgs.msg import Odometry
 
 from diffbot_sim.control import four_wheel_steering_controller as fws
 from diffbot_sim.errors import ModelError
-from diffbot_sim.messages import common as ros_msgs
-from diffbot_sim.messages import steering
+from diffbot_sim.messages import common as ros_msgs, steering
 from diffbot_sim.plugins.base import join
 from diffbot_sim.plugins.ros_control.ackermann_steering import POSITION, VELOCITY, claim, cylinder_radius
 from diffbot_sim.plugins.ros_control.controller import Controller

@@ -15,9 +15,7 @@ import rospy
 from sensor_msgs.msg import JointState
 
 from diffbot_sim.control import franka_gripper as fg
-from diffbot_sim.messages import common as ros_msgs
-from diffbot_sim.messages import controllers as cm
-from diffbot_sim.messages import franka as franka_messages
+from diffbot_sim.messages import common as ros_msgs, controllers as cm, franka as franka_messages
 from diffbot_sim.plugins.base import join, next_due
 from diffbot_sim.plugins.ros_control.controller import Controller, action_server
 

@@ -13,8 +13,7 @@ from sensor_msgs.msg import JointState
 
 from diffbot_sim.control import franka as fk
 from diffbot_sim.errors import ConfigError, ModelError
-from diffbot_sim.messages import common as ros_msgs
-from diffbot_sim.messages import franka as franka_messages
+from diffbot_sim.messages import common as ros_msgs, franka as franka_messages
 from diffbot_sim.plugins.base import join, next_due
 from diffbot_sim.plugins.ros_control.controller import Controller
 from diffbot_sim.transforms import matrix_rpy, rpy_quaternion

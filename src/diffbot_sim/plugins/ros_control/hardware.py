@@ -26,7 +26,6 @@ kinematically (the implicit PID joints report the torque their motor applied).
 """
 import math
 from dataclasses import dataclass
-from typing import Optional
 
 from diffbot_sim.control.angles import shortest_angular_distance, shortest_angular_distance_with_limits
 from diffbot_sim.control.joint_limits import JointLimitsInterfaceError, register_joint_limits
@@ -58,18 +57,18 @@ class SimJoint:
     effort_limit: float  # N·m or N; inf without a limit
     velocity_limit: float  # rad/s or m/s; inf without a limit
     limit_handle: object = None
-    pid: Optional[Pid] = None  # explicit PID (None: no gains, or run as an implicit motor)
+    pid: Pid | None = None  # explicit PID (None: no gains, or run as an implicit motor)
     implicit: bool = False  # a PID joint run as PyBullet's motor
     command: float = 0.0
-    position: Optional[float] = None  # unwrapped (readSim); None before the first read
+    position: float | None = None  # unwrapped (readSim); None before the first read
     velocity: float = 0.0
     effort: float = 0.0
-    frozen: Optional[float] = None  # e-stop: the position held
+    frozen: float | None = None  # e-stop: the position held
     pushed: object = None  # the last motor setting given to PyBullet (skipped when unchanged)
     #: a controller whose own PID is unstable on this joint hands it targets instead of efforts: "position" or
     #: "velocity", driven by PyBullet's motor with at most ``target_force`` (None: the effort limit)
-    target_mode: Optional[str] = None
-    target_force: Optional[float] = None
+    target_mode: str | None = None
+    target_force: float | None = None
 
     @property
     def motor_force(self):
@@ -278,7 +277,7 @@ class RobotHWSim:
                 joint.effort = effort
                 torques.append(effort)
                 torque_idx.append(joint.index)
-            elif method == POSITION or method == POSITION_PID:
+            elif method in (POSITION, POSITION_PID):
                 setting = ("p", command)
                 if joint.pushed != setting:
                     robot.set_positions([joint.index], [command],

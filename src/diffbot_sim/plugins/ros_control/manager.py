@@ -14,14 +14,16 @@ import threading
 
 import rospy
 
-from diffbot_sim.control import ackermann_steering_controller as asc
-from diffbot_sim.control import controller_lookup
-from diffbot_sim.control import controller_switching as switching
-from diffbot_sim.control import diff_drive_config as ddc_cfg
-from diffbot_sim.control import forward_command as fwd
-from diffbot_sim.control import four_wheel_steering_controller as fws
-from diffbot_sim.control import gripper_action_controller as gac
-from diffbot_sim.control import joint_trajectory_config as jtc_cfg
+from diffbot_sim.control import (
+    ackermann_steering_controller as asc,
+    controller_lookup,
+    controller_switching as switching,
+    diff_drive_config as ddc_cfg,
+    forward_command as fwd,
+    four_wheel_steering_controller as fws,
+    gripper_action_controller as gac,
+    joint_trajectory_config as jtc_cfg,
+)
 from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.plugins.base import get_param, join
 from diffbot_sim.plugins.ros_control.ackermann_steering import AckermannSteeringController

@@ -19,7 +19,6 @@ Gazebo). The e-stop is stored and has no effect (upstream's writeSim ignores it)
 """
 import math
 from dataclasses import dataclass
-from typing import Optional
 
 from diffbot_sim.control import steer_bot_hardware as sbh
 from diffbot_sim.control.angles import shortest_angular_distance
@@ -37,8 +36,8 @@ class Handle:
     """One hardware handle: its buffers as the controllers and joint_state_controller see them."""
 
     name: str
-    interface: Optional[str]  # None: state only
-    index: Optional[int] = None  # PyBullet joint of a virtual joint; None for the bicycle model's two
+    interface: str | None  # None: state only
+    index: int | None = None  # PyBullet joint of a virtual joint; None for the bicycle model's two
     command: float = 0.0
     position: float = 0.0
     velocity: float = 0.0
