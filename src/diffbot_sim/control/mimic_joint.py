@@ -183,13 +183,15 @@ class MimicCore:
 
     def effort(self, master_position, mimic_position, dt) -> float | None:
         """With ``<hasPID>``: :meth:`update`'s effort (N·m or N) as a number, or None when it does nothing (the
-        plugin's every step, without building an action)."""
-        config = self.config
+        plugin's every step, without building an action). Without it: None (the joint is positioned instead)."""
+        config, pid = self.config, self._pid
+        if pid is None:  # no <hasPID>: the joint is positioned (update), never pushed
+            return None
         target = master_position * config.multiplier + config.offset
         if not abs(target - mimic_position) >= config.sensitiveness:
             return None
         limit = config.max_effort
-        return max(min(self._pid.compute(target - mimic_position, dt), limit), -limit)  # ignition_clamp
+        return max(min(pid.compute(target - mimic_position, dt), limit), -limit)  # ignition_clamp
 
 
 def urdf_mimic_target(master_position, mimic):

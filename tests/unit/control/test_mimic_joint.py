@@ -146,3 +146,9 @@ def test_effort_is_updates_number_and_state():
         assert by_effort.effort(master, mimic, 0.001) == (None if action is None else action.value)
     assert by_effort.effort(0.3, 0.295, 0.001) is None  # within sensitiveness
     assert by_effort.effort(1.0, 0.0, 0.001) == 5.0  # clamped to maxEffort
+
+
+def test_effort_without_pid_is_none():
+    # without <hasPID> the mimic joint is positioned (update's "position" action), never pushed: no effort
+    mimic = MimicCore(config(), PidGains(p=10.0))
+    assert mimic.effort(1.0, 0.0, 0.001) is None and mimic.update(1.0, 0.0, 0.001) == ("position", 1.0)
