@@ -8,7 +8,7 @@ gathered every physics step and judged every ``1/update_rate`` s of sim time (up
 which would make a run's grasps depend on the machine's speed). ``disable_collisions_on_attach`` turns the
 held object's collisions with the robot off while attached, as upstream.
 """
-from diffbot_sim.control.grasp_fix import GraspFixCore, grasp_contact, grasp_fix_config
+from diffbot_sim.control.grasp_fix import GraspContact, GraspFixCore, grasp_contact, grasp_fix_config
 from diffbot_sim.errors import PluginNotLoaded
 from diffbot_sim.plugins.base import Plugin
 
@@ -20,8 +20,8 @@ class GraspFix(Plugin):
         self.ctx, self.cfg, self.path = ctx, cfg, path
         self.core = GraspFixCore(cfg)
         self.links = sorted({link for arm in cfg.arms for link in arm.gripper_links})
-        self.contacts = []  # raw contacts since the last decision
-        self.joints_held = {}  # (arm, object) -> physics handle
+        self.contacts: list[GraspContact] = []  # raw contacts since the last decision
+        self.joints_held: dict[tuple[str, tuple[int, int]], object] = {}  # (arm, object) -> physics handle
         self.next_decision = 0.0
         ctx.warnings.extend(cfg.notes)
 
@@ -39,7 +39,7 @@ class GraspFix(Plugin):
         if touching:
             dynamic = {uid for uid, body in world.world_bodies if not body.static}
             dynamic |= {r.body for r in world.robots if r is not robot}
-        step = {}
+        step: dict[tuple[str, tuple[int, int]], tuple[list, list]] = {}  # (link, object) -> (points, forces)
         for link, other, other_link, point, force in touching:
             if other in dynamic:
                 entry = step.setdefault((link, (other, other_link)), ([], []))

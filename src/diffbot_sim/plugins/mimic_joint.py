@@ -109,7 +109,7 @@ def create(ctx, element, path, params):
 
 def _with_namespace(ctx, element):
     """The plugin's tags, with the robot's namespace (``~robots``) standing in for its robotNamespace."""
-    tags = {}
+    tags: dict[str, str] = {}
     for child in element:
         tags.setdefault(child.tag, (child.text or "").strip())
     namespace = ctx.plugin_namespace(tags.get("robotNamespace") or None, "")

@@ -24,8 +24,9 @@ from diffbot_sim.values import tag_number
 
 DEFAULT_SIM_TYPE = "gazebo_ros_control/DefaultRobotHWSim"
 #: robotSimType -> the hardware simulated for it (built as ``cls(ctx, ns, warnings)``); others: the default
-HW_SIMS = {DEFAULT_SIM_TYPE: RobotHWSim, "steer_bot_hardware_gazebo/SteerBotHardwareGazebo": SteerBotHWSim,
-           "franka_gazebo/FrankaHWSim": FrankaHWSim}
+HW_SIMS: dict[str, type[RobotHWSim] | type[SteerBotHWSim]] = {
+    DEFAULT_SIM_TYPE: RobotHWSim, "steer_bot_hardware_gazebo/SteerBotHardwareGazebo": SteerBotHWSim,
+    "franka_gazebo/FrankaHWSim": FrankaHWSim}
 
 
 class RosControl(Plugin):
@@ -85,7 +86,7 @@ class RosControl(Plugin):
     def summary(self):
         out = {"robot_namespace": self.ns, "control_period": self.manager.control_period,
                "robot_sim_type": self.sim_type}
-        methods = {}
+        methods: dict[str, list[str]] = {}
         for joint in self.hw.joints.values():
             methods.setdefault(joint.method + ("(implicit)" if joint.implicit else ""), []).append(joint.name)
         for method, names in sorted(methods.items()):

@@ -45,7 +45,9 @@ class FourWheelSteeringController(Controller):
             ctx.warnings.append(f"{name}: four_wheel_steering_msgs is not built (overlay left out): no "
                                 "cmd_four_wheel_steering, no odom_steer")
         self._lock = threading.Lock()
-        self._twist = self._four = None
+        # the newest commands from the callbacks: (linear x, linear y, angular z), (speed, front, rear steering)
+        self._twist: tuple[float, float, float] | None = None
+        self._four: tuple[float, float, float] | None = None
         self.sub = self.own(ctx.subscriber(join(name, "cmd_vel"), Twist, self._on_twist, queue_size=1))
         self.sub_4ws = (self.own(ctx.subscriber(join(name, "cmd_four_wheel_steering"), self.msgs.FourWheelSteering,
                                                 self._on_four, queue_size=1)) if self.msgs else None)

@@ -45,7 +45,7 @@ from diffbot_sim.control.pid import STABILITY_MARGIN, Pid, explicit_loop_margin,
 from diffbot_sim.errors import ConfigError, PluginNotLoaded
 from diffbot_sim.plugins.base import get_param, join
 from diffbot_sim.plugins.ros_control.franka_services import FrankaServices
-from diffbot_sim.plugins.ros_control.hardware import EFFORT, RobotHWSim, _truncate
+from diffbot_sim.plugins.ros_control.hardware import EFFORT, RobotHWSim, SimJoint, _truncate
 
 SIMPLE = "transmission_interface/SimpleTransmission"
 
@@ -59,7 +59,8 @@ class FrankaHWSim(RobotHWSim):
     def __init__(self, ctx, ns, warnings):
         self.ctx, self.ns, self.estop = ctx, ns, False
         model, robot = ctx.model, ctx.robot
-        self.joints, self._interfaces = {}, {}
+        self.joints: dict[str, SimJoint] = {}
+        self._interfaces: dict[str, list[str]] = {}  # joint -> its transmissions' interfaces
         for trans in model.transmissions:
             if trans.type != SIMPLE:
                 continue  # upstream reads joints only from SimpleTransmissions

@@ -248,7 +248,7 @@ class RobotHWSim:
             mode = joint.target_mode
             if mode is not None:
                 force = joint.motor_force if joint.target_force is None else joint.target_force
-                setting = ("p" if mode == "position" else "v", command, force)
+                setting: tuple = ("p" if mode == "position" else "v", command, force)
                 if joint.pushed != setting:  # motor targets persist in PyBullet: given only when changed
                     if mode == "position":
                         robot.set_positions([joint.index], [command], [force])

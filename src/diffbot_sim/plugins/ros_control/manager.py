@@ -11,6 +11,7 @@ trajectory controllers, PID controllers, the effort gripper) run every physics s
 them between updates, so a slower update changes nothing but the CPU spent.
 """
 import threading
+from collections.abc import Callable
 
 import rospy
 
@@ -27,6 +28,7 @@ from diffbot_sim.control import (
 from diffbot_sim.errors import ConfigError, ModelError
 from diffbot_sim.plugins.base import get_param, join
 from diffbot_sim.plugins.ros_control.ackermann_steering import AckermannSteeringController
+from diffbot_sim.plugins.ros_control.controller import Controller
 from diffbot_sim.plugins.ros_control.diff_drive import DiffDriveController
 from diffbot_sim.plugins.ros_control.forward_command import ForwardCommandController
 from diffbot_sim.plugins.ros_control.four_wheel_steering import FourWheelSteeringController
@@ -43,11 +45,11 @@ JSC_TYPE = JointStateController.type
 
 def _factories():
     """controller type -> ``factory(ctx, hw, full_name, params, manager_ns)``."""
-    table = {ddc_cfg.CONTROLLER_TYPE: lambda ctx, hw, name, params, ns: DiffDriveController(ctx, hw, name, params),
-             JSC_TYPE: JointStateController,
-             asc.CONTROLLER_TYPE: lambda ctx, hw, name, params, ns: AckermannSteeringController(ctx, hw, name, params),
-             fws.CONTROLLER_TYPE: lambda ctx, hw, name, params, ns: FourWheelSteeringController(ctx, hw, name,
-                                                                                               params)}
+    table: dict[str, Callable[..., Controller]] = {
+        ddc_cfg.CONTROLLER_TYPE: lambda ctx, hw, name, params, ns: DiffDriveController(ctx, hw, name, params),
+        JSC_TYPE: JointStateController,
+        asc.CONTROLLER_TYPE: lambda ctx, hw, name, params, ns: AckermannSteeringController(ctx, hw, name, params),
+        fws.CONTROLLER_TYPE: lambda ctx, hw, name, params, ns: FourWheelSteeringController(ctx, hw, name, params)}
     for kind in fwd.CONTROLLER_TYPES:
         table[kind] = lambda ctx, hw, name, params, ns: ForwardCommandController(ctx, hw, name, params)
     for kind in jtc_cfg.CONTROLLER_TYPES:
@@ -211,7 +213,7 @@ class ControllerManager:
         """[(name, 'running' | 'stopped', type, {interface: [joints]})] for ListControllers."""
         out = []
         for name, controller in self.loaded.items():
-            claimed = {}
+            claimed: dict[str, list[str]] = {}
             if controller.type == JSC_TYPE:  # it reads every joint and claims none, as controller_manager lists it
                 claimed["JointStateInterface"] = []
             for joint in sorted(controller.joints()):

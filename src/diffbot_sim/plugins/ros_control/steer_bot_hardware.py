@@ -71,7 +71,7 @@ class SteerBotHWSim:
         if missing:
             raise PluginNotLoaded(f"{SIM_TYPE}: virtual joint(s) {', '.join(missing)} of "
                                   f"{join(ns, sbh.PARAM_NS)} are not movable joints of the model")
-        self.joints = {}  # upstream's registration order: steers, then wheels
+        self.joints: dict[str, Handle] = {}  # upstream's registration order: steers, then wheels
         self._add(cfg.front_steer, POSITION)
         for name in cfg.virtual_front_steers:
             self._add(name, POSITION, robot.joint_index[name])
