@@ -10,9 +10,9 @@ import rospy
 from gazebo_msgs.srv import GetLinkState
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from simtest import wait_for  # noqa: E402
+from simtest import wait_for
 
-from diffbot_sim.description.urdf_model import parse_urdf  # noqa: E402
+from diffbot_sim.description.urdf_model import parse_urdf
 
 
 def quat_mul(a, b):

@@ -20,8 +20,8 @@ from controller_manager_msgs.srv import ListControllers
 from sensor_msgs.msg import JointState
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from armtest import Arm, close, trajectory  # noqa: E402
-from simtest import Latest, wait_for  # noqa: E402
+from armtest import Arm, close, trajectory
+from simtest import Latest, wait_for
 
 NS = "/my_arm"  # arm_cell.launch's robot_name: its <group ns>, spawn_model -model and -robot_namespace
 ARM = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"]

@@ -27,11 +27,11 @@ from std_srvs.srv import Empty
 from trajectory_msgs.msg import JointTrajectory
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from armtest import trajectory  # noqa: E402
-from simtest import Latest, wait_for  # noqa: E402
-from traittest import Manager, Rosout, Truth, settled, sim_now, sim_sleep  # noqa: E402
+from armtest import trajectory
+from simtest import Latest, wait_for
+from traittest import Manager, Rosout, Truth, settled, sim_now, sim_sleep
 
-from diffbot_sim.check.arm_check import pose_errors  # noqa: E402
+from diffbot_sim.check.arm_check import pose_errors
 
 ROBOTS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "robots")
 ARMS = {"pos": "position_group", "vel": "velocity_group", "eff": "effort_position_group"}

@@ -14,8 +14,8 @@ from actionlib_msgs.msg import GoalStatus
 from control_msgs.msg import FollowJointTrajectoryResult as Result
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from armtest import Arm, close, trajectory  # noqa: E402
-from traittest import sim_sleep  # noqa: E402
+from armtest import Arm, close, trajectory
+from traittest import sim_sleep
 
 JOINTS = ["joint_1", "joint_2", "joint_3"]
 TARGET = [0.8, 1.0, 0.6]  # joint_2 tilts the arm 1 rad, joint_3 bends it further: a long lever against gravity

@@ -43,10 +43,10 @@ from std_msgs.msg import Float64, Float64MultiArray
 from std_srvs.srv import Empty
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from simtest import Latest, action_done, wait_for  # noqa: E402
-from traittest import Manager, Truth, settled, sim_now, sim_sleep, spawn_box  # noqa: E402
+from simtest import Latest, action_done, wait_for
+from traittest import Manager, Truth, settled, sim_now, sim_sleep, spawn_box
 
-from diffbot_sim.transforms import compose  # noqa: E402
+from diffbot_sim.transforms import compose
 
 ROBOTS = {"grip_effort": (0.0, 0.0), "grip_position": (0.0, 1.0), "mimic": (1.5, 0.0), "mimic_swapped": (1.5, 1.0),
           "urdf_mimic": (1.5, 2.0), "limits": (3.0, 0.0), "grasp": (0.0, 2.5)}
@@ -408,7 +408,10 @@ class ArmTraits(unittest.TestCase):
         spawn_box("slippery_box", (0.04, 0.04, 0.04), 0.1, (x, y, 0.0705), mu=0.05)
         fingers.publish(Float64MultiArray(data=[-3.0, -3.0]))
         sim_sleep(1.0)  # gripped at 10 Hz: attached after more than 3 counts
-        box = lambda: list(self.truth.object("slippery_box")[0])  # noqa: E731
+
+        def box():
+            return list(self.truth.object("slippery_box")[0])
+
         start = settled(box, 0.0005, what="the gripped box")
         self.assertAlmostEqual(start[2], 0.07, delta=0.003, msg="the box is not on the base")
         lift.publish(Float64(0.0))

@@ -24,9 +24,9 @@ from geometry_msgs.msg import Twist
 from trajectory_msgs.msg import JointTrajectory
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from armtest import Arm, close, trajectory  # noqa: E402
-from simtest import Latest, wait_for  # noqa: E402
-from traittest import sim_now, sim_sleep  # noqa: E402
+from armtest import Arm, close, trajectory
+from simtest import Latest, wait_for
+from traittest import sim_now, sim_sleep
 
 JOINTS = ["shoulder_yaw_joint", "shoulder_pitch_joint", "elbow_joint", "wrist_joint"]
 HOME = [0.0, 0.0, 0.0, 0.0]

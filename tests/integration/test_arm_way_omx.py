@@ -14,7 +14,7 @@ import rospy
 import rostest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from fixedarm import FixedArmCase  # noqa: E402
+from fixedarm import FixedArmCase
 
 JOINTS = ["joint1", "joint2", "joint3", "joint4"]
 SPAWNED = [0.0, -1.0, 0.3, 0.7]  # omx_gazebo.launch's -J

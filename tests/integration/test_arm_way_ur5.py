@@ -22,7 +22,7 @@ import rospy
 import rostest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from fixedarm import FixedArmCase  # noqa: E402
+from fixedarm import FixedArmCase
 
 JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"]
 VIA = [0.3, -0.6, 0.5, -0.3, 0.2, 0.4]

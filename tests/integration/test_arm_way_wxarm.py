@@ -14,7 +14,7 @@ import rospy
 import rostest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from fixedarm import FixedArmCase  # noqa: E402
+from fixedarm import FixedArmCase
 
 JOINTS = ["waist", "shoulder", "elbow", "wrist_angle", "wrist_rotate"]
 VIA = [0.3, 0.35, -0.2, 0.3, 0.4]

@@ -15,9 +15,9 @@ import rostest
 from std_msgs.msg import Float64
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from fixedarm import FixedArmCase  # noqa: E402
-from simtest import wait_for  # noqa: E402
-from traittest import sim_now  # noqa: E402
+from fixedarm import FixedArmCase
+from simtest import wait_for
+from traittest import sim_now
 
 JOINTS = ["waist", "shoulder", "elbow", "wrist_angle", "wrist_rotate"]
 TARGET = [-0.5, 0.5, -0.3, 0.4, -0.6]

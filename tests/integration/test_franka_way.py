@@ -28,12 +28,12 @@ from franka_msgs.msg import FrankaState
 from std_msgs.msg import Bool, Float64MultiArray
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from armtest import Arm, close, trajectory  # noqa: E402
-from simtest import Latest, action_done, figure, wait_for  # noqa: E402
-from traittest import Truth, paused, settled, sim_now, sim_sleep  # noqa: E402
+from armtest import Arm, close, trajectory
+from simtest import Latest, action_done, figure, wait_for
+from traittest import Truth, paused, settled, sim_now, sim_sleep
 
-from diffbot_sim.description.urdf_model import parse_urdf  # noqa: E402
-from diffbot_sim.transforms import compose, inverse, rpy_quaternion  # noqa: E402
+from diffbot_sim.description.urdf_model import parse_urdf
+from diffbot_sim.transforms import compose, inverse, rpy_quaternion
 
 ARM = [f"panda_joint{i}" for i in range(1, 8)]
 START = [0.0, -0.785398163, 0.0, -2.35619449, 0.0, 1.57079632679, 0.785398163397]  # panda.launch's -J

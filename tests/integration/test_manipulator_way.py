@@ -16,9 +16,9 @@ from controller_manager_msgs.srv import ListControllers
 from geometry_msgs.msg import Twist
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from armtest import Arm, close, trajectory  # noqa: E402
-from simtest import wait_for  # noqa: E402
-from traittest import sim_sleep  # noqa: E402
+from armtest import Arm, close, trajectory
+from simtest import wait_for
+from traittest import sim_sleep
 
 ARM = ["joint1", "joint2", "joint3", "joint4"]
 MODEL = "robot"  # spawn_model -model robot

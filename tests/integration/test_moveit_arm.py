@@ -19,7 +19,7 @@ import rospy
 import rostest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from moveittest import Body, angle_between, fk, settled_pose, state_valid, tf_pose, wait_for_move_group  # noqa: E402,E501
+from moveittest import Body, angle_between, fk, settled_pose, state_valid, tf_pose, wait_for_move_group
 
 ARM = ["shoulder_yaw_joint", "shoulder_pitch_joint", "elbow_joint", "wrist_joint"]
 TOOL = "gripper_tcp_link"

@@ -21,11 +21,11 @@ import rospy
 import rostest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from moveittest import wait_for_move_group  # noqa: E402
-from traittest import settled  # noqa: E402
+from moveittest import wait_for_move_group
+from traittest import settled
 
-from diffbot_sim.control.pick_place import Scene  # noqa: E402
-from diffbot_sim.transforms import roll_pitch_from_quaternion  # noqa: E402
+from diffbot_sim.control.pick_place import Scene
+from diffbot_sim.transforms import roll_pitch_from_quaternion
 
 BOX = "pick_box::link"
 NODE_TIMEOUT = 600.0  # s wall

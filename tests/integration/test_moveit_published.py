@@ -18,7 +18,7 @@ import rospy
 import rostest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from moveittest import Body, fk, settled_pose, tf_pose, wait_for_move_group  # noqa: E402
+from moveittest import Body, fk, settled_pose, tf_pose, wait_for_move_group
 
 ARM = ["joint1", "joint2", "joint3", "joint4"]
 TOOL = "end_effector_link"

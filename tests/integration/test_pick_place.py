@@ -24,13 +24,13 @@ from gazebo_msgs.msg import LinkStates
 from gazebo_msgs.srv import GetLinkState
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from simtest import wait_for  # noqa: E402
-from traittest import settled, sim_now  # noqa: E402
+from simtest import wait_for
+from traittest import settled, sim_now
 
-from diffbot_sim.check.arm_check import forward_kinematics  # noqa: E402
-from diffbot_sim.control.pick_place import Scene  # noqa: E402
-from diffbot_sim.description.urdf_model import parse_urdf  # noqa: E402
-from diffbot_sim.transforms import compose, inverse, roll_pitch_from_quaternion  # noqa: E402
+from diffbot_sim.check.arm_check import forward_kinematics
+from diffbot_sim.control.pick_place import Scene
+from diffbot_sim.description.urdf_model import parse_urdf
+from diffbot_sim.transforms import compose, inverse, roll_pitch_from_quaternion
 
 MODEL = "diffbot_arm"
 BOX = "pick_box::link"
