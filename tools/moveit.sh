@@ -178,11 +178,14 @@ build_stage() {  # $1: what it is, then the packages; catkin_make_isolated's pro
 }
 t0=$SECONDS
 log "building $WS (the first time about an hour on 2 cores; a rebuild only what changed)"
-# First everything but eigenpy and what needs it (the planning interface's Python module, moveit_commander): MoveIt's
-# own C++ comes first, so a compile error there shows early; then those three (eigenpy alone is ~45 heavy files).
+# First move_group with what it plans and executes with (OMPL, the kinematics plugins, the controller managers), so
+# a compile error in MoveIt's own C++ shows early and move_group runs before the rest is built; then eigenpy (~45
+# heavy files alone) and the planning interface with what it needs (moveit_commander's side).
+LATER=(eigenpy moveit_ros_planning_interface moveit_commander moveit_ros_manipulation moveit_ros_robot_interaction
+       moveit_ros_warehouse warehouse_ros)
 for stage in core python; do
   if [ "$stage" = core ]; then
-    set -- $(printf '%s\n' "${CORE[@]}" | grep -vx 'eigenpy\|moveit_ros_planning_interface\|moveit_commander')
+    set -- $(printf '%s\n' "${CORE[@]}" | grep -vxF "$(printf '%s\n' "${LATER[@]}")")
   else
     set -- "${CORE[@]}"
   fi
