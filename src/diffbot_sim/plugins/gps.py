@@ -135,8 +135,8 @@ class Gps(Plugin):
             return
         dt = 0.0 if self.last_time is None else now - self.last_time
         self.last_time = now
-        (position, _), velocity, _ = self.ctx.robot.link_motion(self.v["body"])
-        velocity = [m(x, dt) for m, x in zip(self.v["velocity"], velocity)]
+        (position, _), body_velocity, _ = self.ctx.robot.link_motion(self.v["body"])
+        velocity = [m(x, dt) for m, x in zip(self.v["velocity"], body_velocity)]
         for p, vm in zip(self.v["position"], self.v["velocity"]):
             p.current_drift += dt * vm.current_drift  # a velocity bias walks the position, as hector
         measured = [m(x, dt) for m, x in zip(self.v["position"], position)]
