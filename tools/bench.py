@@ -23,6 +23,8 @@ Items (``--only a,b``, or ``make bench ITEMS=a,b``):
   fixed_arm    fast-mode RTF of 6-joint effort arms bolted to the world at a 1 ms step (UR5-like; and the arm
                cell with its gripper, item fixed_arm_cell), against bare PyBullet with a PD, by RTF and by CPU
   lockstep     a Gazebo-style step-and-wait learning environment against fast mode
+  dqn_env      a TurtleBot3-style learning environment (tests/integration/tb3_env.py), 20 fresh runs: every
+               action held one scan period, no crash, the same body motion in every episode of every run
   gym          the Gymnasium environment: env steps per CPU second, against bare PyBullet
   scale        namespaced seed robots kept at real time (scale_rsp: with a robot_state_publisher each)
   fleet        TurtleBot3-class laser robots kept at real time, against bare PyBullet in back-to-back pairs

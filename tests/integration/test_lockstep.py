@@ -192,6 +192,32 @@ class Lockstep(unittest.TestCase):
             while "goal" in (self.states.get().name if self.states.get() else ["goal"]):
                 self.assertLess(time.monotonic(), deadline, "the goal never left model_states")
 
+    def test_4_a_turtlebot3_style_environment_holds_every_action(self):
+        """tb3_env.py in a process of its own (TurtleBot3's environment's traits: its own odometry subscriber made
+        just before its first reset_simulation, the goal model spawned with a 0.5 s sleep, wait_for_message
+        'scan'): no crash, every action held one scan period, and both episodes (the same actions from the same
+        reset) move the body the same at every scan, bit for bit: a command taken even one step late shows.
+        `make bench` item dqn_env runs it 20 times."""
+        import json
+        import os
+        import subprocess
+        script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "tb3_env.py")
+        out = subprocess.run([sys.executable, script, "2", "20", "16"], capture_output=True, text=True, timeout=120)
+        lines = [line for line in out.stdout.splitlines() if line.startswith("{")]
+        self.assertTrue(lines, f"tb3_env.py printed no record: {out.stderr[-600:]}")
+        record = json.loads(lines[-1])
+        self.assertIsNone(record["error"], record["error"])
+        spans = record["spans"]
+        print(f"FIGURE tb3_env: {len(spans)} actions in {record['wall_s']:.1f} s wall, spans {min(spans):.3f}-"
+              f"{max(spans):.3f} s, {record['counts']}", flush=True)
+        self.assertTrue(spans and np.allclose(spans, SCAN_PERIOD, atol=1e-6), f"action spans {spans}")
+        from tb3_env import same_motion
+        (first, second), starts = record["trajectories"], record["starts"]
+        self.assertNotIn(None, first + second, "an odometry pose missing at a scan's stamp")
+        self.assertTrue(same_motion(first, starts[0], second, starts[1]),
+                        f"the same actions from the same reset moved the body differently (first scans at "
+                        f"{starts}): {first} against {second}")
+
 
 if __name__ == "__main__":
     rostest.rosrun("diffbot_sim", "loop_lockstep", Lockstep, sys.argv)

@@ -3,6 +3,12 @@
 - ``lockstep``: a Gazebo-style step-and-wait learning environment (publish cmd_vel, rospy.wait_for_message
   /scan, 5 Hz laser) against fast mode: steps per second, the sim time each action was held (median and 95th
   percentile; one scan period is right).
+- ``dqn_env``: tests/integration/tb3_env.py (TurtleBot3's learning environment's traits: its own odometry
+  subscriber made just before its first reset_simulation, goal models spawned and deleted with 0.5 s sleeps,
+  wait_for_message scan) 20 times, each a fresh simulator in fast mode and a fresh environment process, as a
+  user starting a training run: per run the sim time each action was held (min / median / max; one scan period
+  is right), a crash, and whether every episode of every run moved the body the same at every scan (the same
+  actions from the same reset: a command taken late shows).
 - ``gym``: tools/gym_speed.py: in-process env steps per second per core, its ratio to bare PyBullet, resets
   per second.
 """
@@ -21,6 +27,8 @@ from benchkit.stats import percentile
 from diffbot_sim.waiting import wait_for
 
 LASER_ROBOT = os.path.join(ROBOTS, "laser_robot.urdf")
+LASER_ROOM = os.path.join(ROOT, "tests", "data", "worlds", "laser_room.world")
+TB3_ENV = os.path.join(ROOT, "tests", "integration", "tb3_env.py")
 
 
 def probe_lockstep(options):
@@ -56,6 +64,33 @@ def lockstep(steps, repeats):
     return dict(best, steps_per_s_runs=[t["steps_per_s"] for t in trials])
 
 
+def dqn_env(runs, episodes, steps):
+    """``runs`` runs of tb3_env.py (``episodes`` x ``steps``, the same seed), each against a fresh simulator."""
+    sys.path.insert(0, os.path.dirname(TB3_ENV))
+    from tb3_env import same_motion
+    per_run, reference = [], None
+    for k in range(runs):
+        with Launch(sim_args("real_time:=false", f"model:={LASER_ROBOT}", "robot_state_publisher:=false",
+                             f"world:={LASER_ROOM}"), f"dqn_env{k}") as launch:
+            out = subprocess.run([sys.executable, TB3_ENV, str(episodes), str(steps), "16"], env=launch.env,
+                                 capture_output=True, text=True, timeout=900, stdin=subprocess.DEVNULL)
+        lines = [line for line in out.stdout.splitlines() if line.startswith("{")]
+        record = json.loads(lines[-1]) if lines else {"error": f"no record: {out.stderr.strip()[-300:]}"}
+        spans, trajectories = record.get("spans") or [], record.get("trajectories") or []
+        starts = record.get("starts") or []
+        if reference is None and trajectories:
+            reference = (trajectories[0], starts[0])
+        error = (record.get("error") or "").splitlines()
+        per_run.append({"actions": len(spans), "min_s": min(spans, default=None),
+                        "median_s": statistics.median(spans) if spans else None, "max_s": max(spans, default=None),
+                        "off": sum(abs(s - 0.2) > 1e-6 for s in spans), "error": error[0] if error else None,
+                        "same_body": bool(trajectories) and all(same_motion(t, s, *reference)
+                                                                 for t, s in zip(trajectories, starts)),
+                        "steps_per_s": len(spans) / record["wall_s"] if record.get("wall_s") else None})
+    right = [r for r in per_run if r["actions"] and not r["off"] and not r["error"] and r["same_body"]]
+    return {"runs": per_run, "right": len(right), "crashed": sum(bool(r["error"]) for r in per_run)}
+
+
 def gym():
     out = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "gym_speed.py")],
                          capture_output=True, text=True, timeout=1200)
@@ -74,6 +109,19 @@ def lockstep_rows(r):
              "0.2 / 0.2 (one scan)")]
 
 
+def dqn_env_rows(r):
+    if not r.get("dqn_env"):
+        return []
+    d = r["dqn_env"]
+    runs = [x for x in d["runs"] if x["actions"]]
+    medians = [x["median_s"] for x in runs]
+    return [(f"TurtleBot3-style env (tb3_env.py), {len(d['runs'])} fresh runs: right / crashed",
+             f"{d['right']} / {d['crashed']}", f"{len(d['runs'])} / 0"),
+            ("  action spans over the runs: min / median / max",
+             f"{min(x['min_s'] for x in runs):.3f} / {statistics.median(medians):.3f} / "
+             f"{max(x['max_s'] for x in runs):.3f} s" if runs else "-", "0.2 / 0.2 / 0.2 (one scan)")]
+
+
 def gym_rows(r):
     if not r.get("gym"):
         return []
@@ -84,5 +132,6 @@ def gym_rows(r):
 
 
 ITEMS = [Item("lockstep", lambda q: lockstep(50 if q else 300, 1 if q else 3), lockstep_rows),
+         Item("dqn_env", lambda q: dqn_env(2 if q else 20, 2, 15 if q else 40), dqn_env_rows),
          Item("gym", lambda q: gym(), gym_rows)]
 PROBES = {"lockstep": probe_lockstep}

@@ -195,7 +195,7 @@ class GazeboApi:
         self.joints.advertise(service)
         for name, action in (("pause_physics", self.sim.pause), ("unpause_physics", self.sim.unpause),
                              ("reset_simulation", self.sim.reset_simulation), ("reset_world", self.sim.reset_world)):
-            service(name, Empty, lambda _req, action=action: self.sim.empty_service(action))
+            service(name, Empty, lambda req, action=action: self.sim.empty_service(action, req))
         self.handles.append(rospy.Subscriber(f"{ns}/set_model_state", gmsg.ModelState, self._on_model_state,
                                              queue_size=10))
         self.handles.append(rospy.Subscriber(f"{ns}/set_link_state", gmsg.LinkState, self._on_link_state,

@@ -278,8 +278,10 @@ class Simulator:
         self.wall0 = time.monotonic()
         self.sim0 = self.sim_time
 
-    def empty_service(self, action):
-        """A std_srvs/Empty handler's body: ``action`` run on the loop."""
+    def empty_service(self, action, request=None):
+        """A std_srvs/Empty handler: ``action`` on the loop (a reset in fast mode after NodeSync.connect_first)."""
+        if action in (self.reset_simulation, self.reset_world) and not self.cfg.real_time and self.cfg.wait_for_nodes:
+            self.sync.connect_first(request, self.publishers())
         self.call(action)
         return EmptyResponse()
 
@@ -291,7 +293,7 @@ class Simulator:
             return
         for name, action in (("pause_physics", self.pause), ("unpause_physics", self.unpause),
                              ("reset_simulation", self.reset_simulation), ("reset_world", self.reset_world)):
-            rospy.Service("~" + name, Empty, lambda _req, action=action: self.empty_service(action))
+            rospy.Service("~" + name, Empty, lambda req, action=action: self.empty_service(action, req))
 
     # -- the loop -----------------------------------------------------------------------------------
     def run(self):

@@ -16,18 +16,26 @@ one that published on a sensor topic, until every node that was subscribed to it
 * is idle: none of its threads is running or runnable (``/proc/<pid>/task/*/stat``: a thread woken by our
   message is runnable at once, so there is no race), i.e. it has done what the message caused, and
 * if it dropped its subscription after the message (``rospy.wait_for_message``: a step-and-wait client),
-  has subscribed again: it has sent its answer and waits for the next message — lockstep.
+  has subscribed again: it has sent its answer and waits for the next message — lockstep; a client known to
+  drop each connection after one message is waited for until it does, however long it stays runnable on a
+  busy machine (a new subscriber is given FRESH_GRACE of idleness to drop it before it counts as one that stays);
+* and the commands it published (``cmd_vel``, ...) have reached our callbacks (:class:`Inflow`): they are in
+  our socket by the time it is idle, but our own rospy thread may not have read them yet, and sim time must not
+  run on under the old command.
 
 A node is found by the subscriber's caller id (the master's ``lookupNode``, then its own ``getPid``); one on
 another host, or one matching ``~wait_for_nodes_ignore`` (rviz by default: it renders all the time), is not
 waited for. A node that keeps the simulator waiting longer than ``~wait_for_nodes_timeout`` wall seconds at
 one message is named in one warning and not waited for again until it subscribes anew: the lag is bounded.
-While it waits, the loop keeps serving requests (services, spawns, resets).
+While it waits, the loop keeps serving requests (services, spawns, resets). A reset first waits until its
+caller's subscriptions to the simulator's topics are connected (:meth:`NodeSync.connect_first`).
 """
 import fnmatch
+import math
 import os
 import select
 import socket
+import struct
 import time
 import xmlrpc.client
 from urllib.parse import urlparse
@@ -36,8 +44,8 @@ import rosgraph
 
 #: wall seconds between two looks at the waited-for nodes
 POLL = 0.0002
-#: wall seconds a subscriber that connected since the previous message is given to drop its connection (a
-#: rospy.wait_for_message client drops it within its 10 ms poll) before it counts as one that stays
+#: wall seconds of idleness a subscriber that connected since the previous message is given to drop its connection
+#: (a rospy.wait_for_message client drops it within its 10 ms poll) before it counts as one that stays
 FRESH_GRACE = 0.05
 LOCAL_HOSTS = ("localhost", "127.0.0.1", "::1")
 
@@ -99,8 +107,11 @@ class NodeSync:
         self.warn = warn
         self.nodes = {}  # caller id -> WatchedNode, or None (not watchable: other host, ignored, gone)
         self.listeners = {}  # publisher -> {caller id: (its connection, fresh)} when it last published
+        self.oneshot = {}  # publisher -> caller ids among them that drop each connection after one message
+        self.busy_seen = {}  # caller id -> wall time it was last seen busy while we waited
         self._connections = {}  # publisher -> the connections it had at its previous message
         self.commanders = set()  # caller ids publishing to the simulator's command topics (note_commanders)
+        self.inflow = Inflow()  # what those publishers sent that has not reached the callbacks yet
         self.seq = {}  # publisher -> its message count when last looked at
         self.waited = 0.0  # wall seconds spent waiting, for the achieved-RTF report
         self.holds = 0
@@ -118,7 +129,7 @@ class NodeSync:
         for conn in list(impl.connections):
             sock = getattr(conn, "socket", None)
             name = getattr(conn, "endpoint_id", None)
-            if name is None or (peek and sock is not None and _closed_by_peer(sock)):
+            if name is None or _closed(conn, sock) or (peek and sock is not None and _closed_by_peer(sock)):
                 continue
             out[conn] = name
         return out
@@ -159,10 +170,25 @@ class NodeSync:
                 before = self._connections.get(pub, {})
                 self._connections[pub] = conns
                 if conns:
-                    # fresh: connected since the previous message, as a one-shot (wait_for_message) subscriber is
-                    self.listeners[pub] = {name: (conn, conn not in before) for conn, name in conns.items()}
+                    self._note_listeners(pub, conns, before)
                     fresh.append(pub)
         return fresh
+
+    def _note_listeners(self, pub, conns, before):
+        """Who got ``pub``'s message: {caller id: (connection, fresh)}, fresh meaning connected since the previous
+        message, as a ``wait_for_message`` client's is. A node listed twice (its old connection closed, not yet
+        noticed by rospy, and a new one) is taken on its new connection. One-shot: a node fresh now that was
+        fresh at the previous message on another connection dropped that one after one message, and will drop
+        this one too (a step-and-wait client)."""
+        previous = self.listeners.get(pub, {})
+        listeners = {}
+        for conn, name in conns.items():
+            fresh = conn not in before
+            if name not in listeners or fresh:
+                listeners[name] = (conn, fresh)
+        self.listeners[pub] = listeners
+        self.oneshot[pub] = {name for name, (conn, fresh) in listeners.items()
+                             if fresh and previous.get(name, (conn, False))[1] and previous[name][0] is not conn}
 
     def note_commanders(self, subscribers):
         """Take the publishers connected to ``subscribers`` (the simulator's command topics) as nodes in the
@@ -176,6 +202,7 @@ class NodeSync:
                 if name and name != "unknown":  # rospy's value before the header is read
                     names.add(name)
         self.commanders = names
+        self.inflow.watch(subscribers)
 
     def watched(self):
         """The nodes in the loop: every node subscribed to a sensor topic when it last published, and every
@@ -209,10 +236,13 @@ class NodeSync:
 
         A listener has answered when it is idle and: still on the connection that got the message (a subscriber
         that stays), unless that connection was fresh (made since the previous message, as a
-        ``wait_for_message`` client's is) and FRESH_GRACE has not passed, in which case the client is given
-        the time to drop it; or on a new connection (a client that dropped the old one and waits again)."""
+        ``wait_for_message`` client's is) and the node either dropped its previous connection after one message
+        (one-shot: it will drop this one too) or has not been idle for FRESH_GRACE yet (a new node: given the
+        time to drop it; idle, as a client between two 10 ms polls of ``wait_for_message``, not busy: on a busy
+        machine a client can stay runnable that long); or on a new connection (a client that dropped the old
+        one and waits again). Then its commands must have reached our callbacks (:meth:`undelivered`)."""
         if not publishers:
-            return self.busy_nodes(now_wall)
+            return self.busy_nodes(now_wall) or self.undelivered()
         out = []
         for pub in publishers:
             now = None
@@ -221,15 +251,31 @@ class NodeSync:
                 if node is None or node.dropped:
                     continue
                 if node.busy(now_wall):
+                    self.busy_seen[name] = now_wall
                     out.append((name, "busy"))
                     continue
                 if now is None:
                     now = self.connections(pub)
                 if conn in now:
-                    if fresh and elapsed < FRESH_GRACE:
+                    idle = now_wall - max(now_wall - elapsed, self.busy_seen.get(name, -math.inf))
+                    if fresh and (name in self.oneshot.get(pub, ()) or idle < FRESH_GRACE):
                         out.append((name, "a new subscriber: dropping it after one message?"))
                 elif name not in now.values():
                     out.append((name, f"not subscribed to {pub.resolved_name} again yet"))
+        return out or self.undelivered()
+
+    def undelivered(self):
+        """(name, why) of the waited-for nodes whose commands have not reached the simulator's callbacks yet.
+        Why: a node's answer is the command it published before it went idle (a step-and-wait client also
+        subscribed again after it); the command's bytes are then in our socket already (loopback), but our
+        rospy thread may not have read them: resumed at once, sim time ran on under the old command for
+        steps (a step-and-wait client's action started 12.5 ms of sim time late and was held 0.1875 s, not
+        0.2 s)."""
+        out = []
+        for name in self.inflow.pending():
+            node = self._node(name)
+            if node is not None and not node.dropped:
+                out.append((name, "its command is not taken in yet"))
         return out
 
     def wait(self, publishers, serve, stop):
@@ -256,6 +302,38 @@ class NodeSync:
             serve()
         self.waited += time.monotonic() - started
 
+    def connect_first(self, request, publishers):
+        """Hold the calling thread (a service's, before ``request`` reaches the loop) until the node that sent it
+        is connected to each of ``publishers`` it subscribes to, at most ``timeout`` wall seconds.
+
+        Why: a client that subscribes (odometry) and at once calls reset_simulation (TurtleBot3's learning
+        environment does) needs its connection up before sim time runs on from 0: in fast mode the first
+        odometry (1/30 s) and scan (0.2 s) come within milliseconds of wall time, and its connection, made by
+        a thread of its own, can come later: it got a scan and no odometry, and crashed. At real time in Gazebo
+        the connection has time to spare."""
+        caller = (getattr(request, "_connection_header", None) or {}).get("callerid")
+        if not caller or caller == self.own_name or any(fnmatch.fnmatch(caller, p) for p in self.ignore):
+            return
+        try:
+            uri = rosgraph.Master(self.own_name).lookupNode(caller)
+            if not _is_local(urlparse(uri).hostname or ""):
+                return
+            code, _, subscribed = xmlrpc.client.ServerProxy(uri).getSubscriptions(self.own_name)
+        except Exception:  # the node left, or does not answer: nothing to wait for
+            return
+        topics = {topic for topic, _ in subscribed} if code == 1 else set()
+        mine = [pub for pub in publishers if getattr(pub, "resolved_name", None) in topics]
+        started = time.monotonic()
+        while True:
+            missing = [pub.resolved_name for pub in mine if caller not in self.connections(pub).values()]
+            if not missing:
+                return
+            if time.monotonic() - started > self.timeout:
+                self.warn(f"sync-connect:{caller}", f"bullet_sim: {caller} subscribed to {', '.join(missing)} but "
+                          f"did not connect within {self.timeout:g} s; going on (~wait_for_nodes_timeout)")
+                return
+            time.sleep(0.001)
+
     def forget_drops(self, publishers):
         """A node that subscribes anew (a fresh connection got this message) is waited for again."""
         for pub in publishers:
@@ -263,6 +341,105 @@ class NodeSync:
                 node = self.nodes.get(name)
                 if fresh and node is not None:
                     node.dropped = False
+
+
+class Inflow:
+    """Which publishers to the simulator's command topics have sent messages its callbacks have not had yet.
+
+    A connection is drained when (1) its socket has nothing to read; (2) every byte the kernel received on it
+    (TCP_INFO's ``tcpi_bytes_received``) has been taken by rospy's receive thread (its ``stat_bytes``, less the
+    handshake's, the smallest difference seen): a thread that read a message while the loop held Python's
+    lock has it in hand, unparsed, until it gets the lock; and (3) every message rospy read from it
+    (``stat_num_msg``) has been through the subscriber's callbacks: a counting callback, added after the
+    plugin's own, notes each message's connection (rospy sets ``msg._connection_header`` to the connection's
+    header)."""
+
+    def __init__(self):
+        self.impls = []  # the command subscribers' rospy impls
+        self.counted = set()  # id() of impls with the counting callback
+        self.done = {}  # id(connection header) -> messages through the callbacks
+        self.base = {}  # id(connection header) -> messages read before the count began
+        self.offset = {}  # id(connection header) -> bytes received that rospy never counts (its handshake)
+
+    def watch(self, subscribers):
+        """Count the deliveries of ``subscribers`` (rospy.Subscriber), from now on."""
+        impls = []
+        for sub in subscribers:
+            impl = getattr(sub, "impl", None)
+            if impl is None or not hasattr(impl, "add_callback"):
+                continue
+            impls.append(impl)
+            if id(impl) not in self.counted:
+                for conn in list(impl.connections):  # read before the count: taken as delivered
+                    header = getattr(conn, "header", None)
+                    if header is not None:
+                        self.base[id(header)] = getattr(conn, "stat_num_msg", 0)
+                try:
+                    impl.add_callback(self._delivered, None)
+                except Exception:  # closed meanwhile (unregistered): nothing to count
+                    continue
+                self.counted.add(id(impl))
+        live = {id(getattr(c, "header", None)) for impl in impls for c in list(impl.connections)}
+        for table in (self.done, self.base, self.offset):  # connections gone: forget them
+            for key in [k for k in list(table) if k not in live]:
+                del table[key]
+        self.impls = impls
+
+    def _delivered(self, msg):
+        """The last callback of a command subscriber (rospy's receive thread): one more message delivered."""
+        key = id(getattr(msg, "_connection_header", None))
+        self.done[key] = self.done.get(key, 0) + 1
+
+    def pending(self):
+        """Caller ids of the publishers whose connection is not drained (see the class docstring)."""
+        out = set()
+        for impl in self.impls:
+            for conn in list(impl.connections):
+                name = getattr(conn, "callerid_pub", None)
+                if not name or name == "unknown" or name in out:
+                    continue
+                sock = getattr(conn, "socket", None)
+                header = getattr(conn, "header", None)
+                if sock is None or header is None:  # closed, or its handshake not done: nothing sent yet
+                    continue
+                if _readable(sock):
+                    out.add(name)
+                    continue
+                received = _bytes_received(sock)
+                if received is not None:
+                    unread = received - getattr(conn, "stat_bytes", 0)
+                    offset = self.offset.get(id(header))
+                    if offset is None or unread < offset:
+                        self.offset[id(header)] = offset = unread
+                    if unread > offset:
+                        out.add(name)
+                        continue
+                if getattr(conn, "stat_num_msg", 0) - self.base.get(id(header), 0) > self.done.get(id(header), 0):
+                    out.add(name)
+        return out
+
+
+def _bytes_received(sock):
+    """Bytes the kernel has received on TCP socket ``sock`` (Linux TCP_INFO ``tcpi_bytes_received``), or None."""
+    try:
+        return struct.unpack_from("Q", sock.getsockopt(socket.IPPROTO_TCP, socket.TCP_INFO, 136), 128)[0]
+    except (OSError, ValueError, AttributeError, struct.error):
+        return None
+
+
+def _readable(sock):
+    """Whether ``sock`` has something to read now (data, or the peer's close), without waiting."""
+    try:
+        readable, _, _ = select.select([sock], [], [], 0.0)
+        return bool(readable)
+    except (OSError, ValueError):
+        return False
+
+
+def _closed(conn, sock):
+    """Whether rospy closed ``conn`` already (its transport ``done``, its socket dropped): it stays in the
+    publisher's list until rospy's cleanup removes it, and must not count as a subscriber that stays."""
+    return getattr(conn, "done", False) or (sock is None and hasattr(conn, "done"))
 
 
 def _closed_by_peer(sock):

@@ -332,3 +332,189 @@ def test_a_node_that_does_not_answer_is_not_watched(node_sync, monkeypatch):
             raise OSError("connection refused")
     monkeypatch.setattr(sync.rosgraph, "Master", Gone)
     assert node_sync._find("/slam") is None
+
+
+# -- step-and-wait clients: a dropped connection is not a staying one, a one-shot client is known again ----------
+
+class RospyConn(Conn):
+    """A connection as rospy's own transport has it: ``done`` once rospy closed it (its socket then None)."""
+
+    def __init__(self, caller, sock=None):
+        super().__init__(caller, sock)
+        self.done = False
+
+
+def test_a_connection_rospy_closed_is_not_a_subscriber(pair):
+    ours, _ = pair
+    scan = Pub()
+    closed, dropped, live = RospyConn("/agent"), RospyConn("/agent", ours), RospyConn("/slam", ours)
+    closed.done = True  # rospy closed it: it stays listed until rospy's cleanup removes it
+    dropped.socket = None
+    scan.impl.connections += [closed, dropped, live]
+    assert NodeSync.connections(scan) == {live: "/slam"}
+    assert NodeSync.connections(scan, peek=False) == {live: "/slam"}
+
+
+def test_a_one_shot_client_is_waited_for_past_the_grace(node_sync):
+    """A client that dropped its connection after one message will drop this one too: however long it takes
+    (a busy machine), it is not taken for a subscriber that stays."""
+    scan = Pub()
+    watch(node_sync, Node("/agent"))
+    first = Conn("/agent")
+    scan.impl.connections.append(first)
+    sent(node_sync, scan)
+    scan.impl.connections[:] = [first, Conn("/agent")]  # the old one closed, not yet noticed; a new one
+    sent(node_sync, scan)
+    assert node_sync.listeners[scan]["/agent"][0] is not first  # taken on its new connection
+    assert node_sync.oneshot[scan] == {"/agent"}
+    assert node_sync.pending([scan], 10.0, elapsed=10.0) == [
+        ("/agent", "a new subscriber: dropping it after one message?")]
+
+
+def test_a_new_subscriber_gets_the_grace_counted_from_its_last_busy_moment(node_sync):
+    scan = Pub()
+    agent, = watch(node_sync, Node("/agent", busy=True))
+    scan.impl.connections.append(Conn("/agent"))
+    sent(node_sync, scan)
+    assert node_sync.pending([scan], 100.0, elapsed=1.0) == [("/agent", "busy")]  # runnable: a busy machine
+    agent.is_busy = False
+    assert node_sync.pending([scan], 100.0 + FRESH_GRACE / 2, elapsed=1.0) == [
+        ("/agent", "a new subscriber: dropping it after one message?")]  # idle only since then
+    assert node_sync.pending([scan], 100.0 + 1.01 * FRESH_GRACE, elapsed=1.0) == []  # it stays
+
+
+# -- commands on their way in ------------------------------------------------------------------------------------
+
+@pytest.fixture
+def tcp_pair():
+    """A loopback TCP connection: (the publisher's end, our subscriber's end)."""
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen()
+    theirs = socket.create_connection(server.getsockname())
+    ours, _ = server.accept()
+    server.close()
+    yield theirs, ours
+    theirs.close()
+    ours.close()
+
+
+class SubImpl(Impl):
+    """rospy's _SubscriberImpl as Inflow reads it: its connections and its callbacks."""
+
+    def __init__(self):
+        super().__init__()
+        self.callbacks = []
+
+    def add_callback(self, cb, cb_args):
+        self.callbacks.append(cb)
+
+    def deliver(self, conn, count=1):
+        """rospy's receive thread: ``count`` messages read from ``conn`` and handed to every callback."""
+        conn.stat_num_msg += count
+        for _ in range(count):
+            msg = type("Msg", (), {"_connection_header": conn.header})()
+            for cb in self.callbacks:
+                cb(msg)
+
+
+def commander(sock, caller="/agent"):
+    conn = RospyConn(None, sock)
+    conn.callerid_pub, conn.header, conn.stat_num_msg, conn.stat_bytes = caller, {"callerid": caller}, 0, 0
+    sub = Sub()
+    sub.impl = SubImpl()
+    sub.impl.connections.append(conn)
+    return sub, conn
+
+
+def drain(sock, conn):
+    """Our rospy thread reads what is waiting (it counts the bytes)."""
+    sock.setblocking(False)
+    try:
+        conn.stat_bytes += len(sock.recv(65536))
+    except BlockingIOError:
+        pass
+
+
+def test_a_command_is_pending_until_its_callback_ran(node_sync, tcp_pair):
+    """The client published its command, then subscribed again and went idle: resumed before our own rospy thread
+    read and delivered the command, sim time ran on under the old one (12.5 ms of sim time, measured)."""
+    theirs, ours = tcp_pair
+    watch(node_sync, Node("/agent"))
+    sub, conn = commander(ours)
+    node_sync.note_commanders([sub])
+    assert node_sync.undelivered() == []
+    theirs.sendall(b"x" * 40)  # the command's bytes, in our socket
+    wait_for_bytes(ours)
+    assert node_sync.undelivered() == [("/agent", "its command is not taken in yet")]
+    assert node_sync.pending([], 0.0) == [("/agent", "its command is not taken in yet")]  # after a tick too
+    drain(ours, conn)
+    conn.stat_num_msg += 1  # read and parsed, its callback not run yet
+    assert node_sync.undelivered() == [("/agent", "its command is not taken in yet")]
+    conn.stat_num_msg -= 1
+    sub.impl.deliver(conn)
+    assert node_sync.undelivered() == []
+
+
+def test_bytes_our_thread_took_from_the_socket_but_has_not_counted_are_pending(node_sync, tcp_pair):
+    """Read by rospy's thread while the loop held Python's lock: out of the socket, not yet counted."""
+    theirs, ours = tcp_pair
+    watch(node_sync, Node("/agent"))
+    sub, conn = commander(ours)
+    theirs.sendall(b"h" * 30)  # the handshake: read by rospy, never counted in stat_bytes
+    wait_for_bytes(ours)
+    ours.recv(30)
+    node_sync.note_commanders([sub])
+    assert node_sync.undelivered() == []  # 30 bytes never counted: the connection's own offset
+    theirs.sendall(b"x" * 40)
+    wait_for_bytes(ours)
+    ours.recv(40)  # taken by the thread, which now waits for the lock
+    assert node_sync.undelivered() == [("/agent", "its command is not taken in yet")]
+    conn.stat_bytes += 40
+    sub.impl.deliver(conn)
+    assert node_sync.undelivered() == []
+
+
+def test_a_dropped_commander_is_not_waited_for(node_sync, tcp_pair):
+    theirs, ours = tcp_pair
+    agent, = watch(node_sync, Node("/agent"))
+    sub, _ = commander(ours)
+    node_sync.note_commanders([sub])
+    theirs.sendall(b"x")
+    wait_for_bytes(ours)
+    agent.dropped = True
+    assert node_sync.undelivered() == []
+
+
+def wait_for_bytes(sock):
+    import select
+    assert select.select([sock], [], [], 2.0)[0], "the bytes never arrived"
+
+
+# -- a reset's caller is connected first ---------------------------------------------------------------------
+
+def request(caller):
+    """A service request as rospy hands it to the handler: its connection header names the caller."""
+    return type("Request", (), {"_connection_header": {"callerid": caller}})()
+
+
+def test_a_reset_waits_until_its_callers_subscriptions_are_connected(node_sync, monkeypatch):
+    import threading
+
+    class Proxy:
+        def __init__(self, address):
+            pass
+
+        def getSubscriptions(self, caller):
+            return 1, "", [["/odom", "nav_msgs/Odometry"], ["/elsewhere", "std_msgs/Empty"]]
+    monkeypatch.setattr(sync.rosgraph, "Master", Master)
+    monkeypatch.setattr(xmlrpc.client, "ServerProxy", Proxy)
+    odom, scan = Pub("/odom"), Pub("/scan")
+    later = threading.Timer(0.05, lambda: odom.impl.connections.append(Conn("/agent")))
+    later.start()
+    node_sync.connect_first(request("/agent"), [odom, scan])  # /scan is not one of its subscriptions
+    assert odom.impl.connections and node_sync.warnings == []
+    node_sync.timeout = 0.02
+    node_sync.connect_first(request("/other"), [odom, scan])  # subscribed, never connected: named, goes on
+    (key, text), = node_sync.warnings
+    assert key == "sync-connect:/other" and "/odom" in text
