@@ -8,6 +8,7 @@ What the rays measure (angles, misses, noise, intensities) is :mod:`diffbot_sim.
 its own ``<pose>`` is dropped, as sdformat's URDF reader replaces it (with a warning when it was not zero).
 """
 import itertools
+from typing import Any
 
 from diffbot_sim.description.urdf_model import tag_value
 from diffbot_sim.errors import ConfigError
@@ -70,7 +71,7 @@ class RaySensorPlugin(Plugin):
         self.rng = rng
         self.processor = ray_sensor.ScanProcessor(cfg, rng)
         self.period = 1.0 / cfg.update_rate if cfg.update_rate > 0 else 0.0
-        self.pub = None
+        self.pub: Any = None  # the sensor's rospy publisher, which each subclass makes (None: it publishes nothing)
         self._ray_key = next(_RAY_KEYS)  # names this sensor's rays to the ray process
         self._waiting = None  # (ticket, sim time, stamp) of a cast the ray process has not answered yet
         self._answer = None  # its answer, for the publish() it is handed to
@@ -95,8 +96,9 @@ class RaySensorPlugin(Plugin):
             self._answer = None
         else:
             cfg = self.cfg
-            fractions, bodies, links = world.ray_batch(*ray_sensor.world_rays(*self._pose(), self.directions,
-                                                                             cfg.range_min, cfg.range_max))
+            position, rotation = self._pose()
+            starts, ends = ray_sensor.world_rays(position, rotation, self.directions, cfg.range_min, cfg.range_max)
+            fractions, bodies, links = world.ray_batch(starts, ends)
         return fractions, world.retro(bodies, links)
 
     def _casts_later(self):
