@@ -7,8 +7,8 @@
   subscriber made just before its first reset_simulation, goal models spawned and deleted with 0.5 s sleeps,
   wait_for_message scan) 20 times, each a fresh simulator in fast mode and a fresh environment process, as a
   user starting a training run: per run the sim time each action was held (min / median / max; one scan period
-  is right), a crash, and whether every episode of every run moved the body the same at every scan (the same
-  actions from the same reset: a command taken late shows).
+  is right), a crash, and whether every episode begun one scan period after its reset, in every run, moved the
+  body the same at every scan (the same actions from the same reset: a command taken late shows).
 - ``gym``: tools/gym_speed.py: in-process env steps per second per core, its ratio to bare PyBullet, resets
   per second.
 """
@@ -67,25 +67,26 @@ def lockstep(steps, repeats):
 def dqn_env(runs, episodes, steps):
     """``runs`` runs of tb3_env.py (``episodes`` x ``steps``, the same seed), each against a fresh simulator."""
     sys.path.insert(0, os.path.dirname(TB3_ENV))
-    from tb3_env import same_motion
-    per_run, reference = [], None
+    from tb3_env import same_starts
+    records = []
     for k in range(runs):
         with Launch(sim_args("real_time:=false", f"model:={LASER_ROBOT}", "robot_state_publisher:=false",
                              f"world:={LASER_ROOM}"), f"dqn_env{k}") as launch:
             out = subprocess.run([sys.executable, TB3_ENV, str(episodes), str(steps), "16"], env=launch.env,
                                  capture_output=True, text=True, timeout=900, stdin=subprocess.DEVNULL)
         lines = [line for line in out.stdout.splitlines() if line.startswith("{")]
-        record = json.loads(lines[-1]) if lines else {"error": f"no record: {out.stderr.strip()[-300:]}"}
-        spans, trajectories = record.get("spans") or [], record.get("trajectories") or []
-        starts = record.get("starts") or []
-        if reference is None and trajectories:
-            reference = (trajectories[0], starts[0])
-        error = (record.get("error") or "").splitlines()
+        records.append(json.loads(lines[-1]) if lines else {"error": f"no record: {out.stderr.strip()[-300:]}"})
+    # the body's motion of the episodes begun one scan period after their reset, the same in every run
+    begun = [json.dumps(t) for r in records for t in same_starts(r, 0.2)]
+    reference = max(set(begun), key=begun.count) if begun else None
+    per_run = []
+    for record in records:
+        spans, error = record.get("spans") or [], (record.get("error") or "").splitlines()
+        same = [json.dumps(t) for t in same_starts(record, 0.2)]
         per_run.append({"actions": len(spans), "min_s": min(spans, default=None),
                         "median_s": statistics.median(spans) if spans else None, "max_s": max(spans, default=None),
                         "off": sum(abs(s - 0.2) > 1e-6 for s in spans), "error": error[0] if error else None,
-                        "same_body": bool(trajectories) and all(same_motion(t, s, *reference)
-                                                                 for t, s in zip(trajectories, starts)),
+                        "starts": record.get("starts"), "same_body": bool(same) and all(t == reference for t in same),
                         "steps_per_s": len(spans) / record["wall_s"] if record.get("wall_s") else None})
     right = [r for r in per_run if r["actions"] and not r["off"] and not r["error"] and r["same_body"]]
     return {"runs": per_run, "right": len(right), "crashed": sum(bool(r["error"]) for r in per_run)}
