@@ -134,6 +134,15 @@ class RobotContext:
     def __post_init__(self):
         self.warnings = []  # start-up warnings of this robot's plugins, logged once in the report
         self.handles = []  # every publisher, subscriber and service this robot's plugins made
+        # resolved JointState topic -> the joints a model plugin (joint state publisher, kobuki) publishes there
+        self.joint_state_topics: dict[str, set[str]] = {}
+
+    def publishes_joint_states(self, pub, joints):
+        """Record that a plugin publishes ``joints`` on ``pub``'s topic: joint_state_controller then leaves them
+        out of the passive joints it adds to that topic. A joint on one topic from two publishers (their
+        messages stamped at the same step) is a state 'not newer than the previous' to MoveIt's
+        CurrentStateMonitor, which then forgets every joint's time and finds the robot's state incomplete."""
+        self.joint_state_topics.setdefault(pub.resolved_name, set()).update(joints)
 
     # -- ROS endpoints: made through the context so that deleting the robot removes every one ---------
     def publisher(self, name, msg_class):

@@ -18,6 +18,7 @@ class JointStatePublisher(Plugin):
         self.cfg = cfg
         self.indices = ctx.robot.indices(cfg.joints)
         self.pub = ctx.publisher(topic or join(cfg.namespace, cfg.topic), JointState)
+        ctx.publishes_joint_states(self.pub, cfg.joints)
         self.builder = ros_msgs.JointStateBuilder(list(cfg.joints))
         self.period = 1.0 / cfg.update_rate if cfg.update_rate > 0 else 0.0
 

@@ -78,6 +78,7 @@ class Kobuki(Plugin):
                                           self._on_reset, queue_size=1)
         self.odom_pub = ctx.publisher(join(ns, "odom"), Odometry)
         self.js_pub = ctx.publisher(join(ns, "joint_states"), JointState)
+        ctx.publishes_joint_states(self.js_pub, self.joints_)
         self.imu_pub = ctx.publisher(join(ns, f"{prefix}/sensors/imu_data"), Imu)
         self.odom_builder = ros_msgs.OdometryBuilder(self.odom_frame, self.base_frame, 0, 0, 0,
                                                      pose_diagonal=POSE_COVARIANCE,

@@ -158,6 +158,52 @@ def test_states_list_what_each_controller_claims(rig):
     ]
 
 
+def joint_state_names(arm_rig, monkeypatch, plugin_topic, autostart):
+    """The joint names joint_state_controller publishes on /joint_states for arm_position_nogains with joint_3 left
+    without its transmission (a passive joint), while a joint state publisher plugin publishes joint_3 on
+    ``plugin_topic``; made before that plugin (``autostart``: the ros_control plugin's autostart runs while the
+    robot's plugins are being created, the joint state publisher last) or after it (a spawner)."""
+    from diffbot_sim.config import JointStateConfig
+    from diffbot_sim.plugins.joint_state import JointStatePublisher
+
+    arm = arm_rig("arm_position_nogains", {"joint_state_controller": JSC}, use_yaml=False)
+    arm.model.transmissions = [t for t in arm.model.transmissions if t.joint != "joint_3"]
+    get_param = parameter_server(arm.params)
+    monkeypatch.setattr(hardware, "get_param", get_param)
+    monkeypatch.setattr(manager, "get_param", get_param)
+    hw = hardware.RobotHWSim(arm.ctx, "/", arm.ctx.warnings)
+    hw.start()
+    cm = manager.ControllerManager(arm.ctx, hw, "/", None)
+
+    def plugin():
+        JointStatePublisher(arm.ctx, JointStateConfig(joints=["joint_3"]), topic=plugin_topic)
+    if not autostart:
+        plugin()
+    controller = cm.load("joint_state_controller")
+    cm.switch(["joint_state_controller"], [], STRICT)
+    if autostart:
+        plugin()
+    run(arm, hw, cm, 0.05)
+    assert controller.pub.name == "/joint_states"
+    published = controller.pub.published
+    assert published, "joint_state_controller published nothing"
+    return {tuple(msg.name) for msg in published}
+
+
+@pytest.mark.parametrize("autostart", [False, True])
+def test_joint_state_controller_leaves_out_a_passive_joint_a_plugin_publishes_on_its_topic(arm_rig, monkeypatch,
+                                                                                          autostart):
+    """Gazebo's joint_state_controller publishes only the hardware joints; ours adds the model's other movable
+    joints for TF, but not one a plugin already puts on the same topic: two messages of one step carrying a joint
+    are, to MoveIt's CurrentStateMonitor, a state 'not newer than the previous', and it then forgets every
+    joint's time (the arm's state incomplete, plans and executions refused)."""
+    assert joint_state_names(arm_rig, monkeypatch, "/joint_states", autostart) == {("joint_1", "joint_2")}
+
+
+def test_joint_state_controller_adds_a_passive_joint_published_only_on_another_topic(arm_rig, monkeypatch):
+    assert joint_state_names(arm_rig, monkeypatch, "/other/joint_states", True) == {("joint_1", "joint_2", "joint_3")}
+
+
 # -- the update schedule ------------------------------------------------------------------------------------
 
 def count_updates(controller):
