@@ -26,7 +26,9 @@ one that published on a sensor topic, until every node that was subscribed to it
 A node is found by the subscriber's caller id (the master's ``lookupNode``, then its own ``getPid``); one on
 another host, or one matching ``~wait_for_nodes_ignore`` (rviz by default: it renders all the time), is not
 waited for. A node that keeps the simulator waiting longer than ``~wait_for_nodes_timeout`` wall seconds at
-one message is named in one warning and not waited for again until it subscribes anew: the lag is bounded.
+one message is named in one warning and not waited for while it stays busy: the lag is bounded. It is waited
+for again once it is seen idle (it caught up: amcl, gmapping and move_base are busy for seconds while they start,
+and dropped for good they then lagged the whole run) or subscribes anew; after MAX_DROPS drops, only anew.
 While it waits, the loop keeps serving requests (services, spawns, resets). A reset first waits until its
 caller's subscriptions to the simulator's topics are connected (:meth:`NodeSync.connect_first`).
 """
@@ -47,6 +49,9 @@ POLL = 0.0002
 #: wall seconds of idleness a subscriber that connected since the previous message is given to drop its connection
 #: (a rospy.wait_for_message client drops it within its 10 ms poll) before it counts as one that stays
 FRESH_GRACE = 0.05
+#: How often a node that outlasted ``~wait_for_nodes_timeout`` is taken back once idle; then only when it
+#: subscribes anew (a node busy nearly all the time would otherwise cost a timeout again and again).
+MAX_DROPS = 3
 LOCAL_HOSTS = ("localhost", "127.0.0.1", "::1")
 
 
@@ -58,7 +63,8 @@ class WatchedNode:
         self.task_dir = f"/proc/{pid}/task"
         self._fds = {}  # tid -> open /proc/<pid>/task/<tid>/stat
         self._listed = -1.0
-        self.dropped = False  # exceeded the timeout: not waited for until it subscribes anew
+        self.dropped = False  # exceeded the timeout: not waited for until it is idle again (or subscribes anew)
+        self.drops = 0  # times it was dropped since it last subscribed anew
 
     def alive(self):
         return os.path.exists(self.task_dir)
@@ -284,6 +290,7 @@ class NodeSync:
         after a /clock tick, until no node in the loop is busy."""
         started = time.monotonic()
         self.holds += 1
+        self.take_back_idle(publishers, started)
         waiting_since = {}
         while True:
             now = time.monotonic()
@@ -296,11 +303,24 @@ class NodeSync:
                     node = self.nodes.get(name)
                     if node is not None:
                         node.dropped = True
+                        node.drops += 1
+                    again = ("until it subscribes again" if node is not None and node.drops >= MAX_DROPS
+                             else "while it is busy")
                     self.warn(f"sync:{name}", f"bullet_sim: {name} kept the simulator waiting {now - since:.1f} s "
-                              f"({why}); not waiting for it until it subscribes again (~wait_for_nodes_timeout)")
+                              f"({why}); not waiting for it {again} (~wait_for_nodes_timeout)")
             time.sleep(POLL)
             serve()
         self.waited += time.monotonic() - started
+
+    def take_back_idle(self, publishers, now_wall):
+        """Wait again for the nodes in this hold that were dropped and are idle now: they have caught up (a node
+        is busy for seconds while it starts: amcl computing its likelihood field, gmapping its first map)."""
+        names = ({name for pub in publishers for name in self.listeners.get(pub, {})} if publishers
+                 else self.watched())
+        for name in names:
+            node = self.nodes.get(name)
+            if node is not None and node.dropped and node.drops < MAX_DROPS and not node.busy(now_wall):
+                node.dropped = False
 
     def connect_first(self, request, publishers):
         """Hold the calling thread (a service's, before ``request`` reaches the loop) until the node that sent it
@@ -340,7 +360,7 @@ class NodeSync:
             for name, (_, fresh) in self.listeners.get(pub, {}).items():
                 node = self.nodes.get(name)
                 if fresh and node is not None:
-                    node.dropped = False
+                    node.dropped, node.drops = False, 0
 
 
 class Inflow:

@@ -37,6 +37,7 @@ class Node:
 
     def __init__(self, name, busy=False, alive=True):
         self.name, self.is_busy, self.is_alive, self.dropped, self.closed = name, busy, alive, False, False
+        self.drops = 0
 
     def alive(self):
         return self.is_alive
@@ -281,6 +282,31 @@ def test_a_node_past_the_timeout_is_named_once_and_dropped(node_sync):
     assert slow.dropped and served and len(served) < 100
     (key, text), = node_sync.warnings
     assert key == "sync:/slow" and "/slow kept the simulator waiting" in text and "(busy)" in text
+
+
+def test_a_dropped_node_is_waited_for_again_once_it_is_idle_at_most_max_drops_times(node_sync):
+    """amcl, gmapping and move_base are busy for seconds while they start: dropped at their first scan and never
+    waited for again, they lagged the whole fast-mode run (amcl's map frame 0.5 s behind: move_base's TF
+    extrapolation errors). Idle at a later message, a dropped node is waited for again; after MAX_DROPS drops,
+    only once it subscribes anew."""
+    node_sync.timeout = 0.0
+    scan = Pub()
+    starting, = watch(node_sync, Node("/amcl", busy=True))
+    scan.impl.connections.append(Conn("/amcl"))
+    for drop in range(1, sync.MAX_DROPS + 1):
+        starting.is_busy = True
+        sent(node_sync, scan)
+        served = []
+        node_sync.wait([scan], lambda: served.append(1), lambda: len(served) > 100)
+        assert starting.dropped and starting.drops == drop
+        starting.is_busy = False
+        sent(node_sync, scan)
+        node_sync.take_back_idle([scan], 0.0)
+        assert starting.dropped == (drop == sync.MAX_DROPS)  # idle: waited for again, but not after MAX_DROPS
+    assert "until it subscribes again" in node_sync.warnings[-1][1]
+    starting.is_busy = True
+    sent(node_sync, scan)
+    assert node_sync.pending([scan], 0.0) == []  # dropped for good: not waited for while busy
 
 
 # -- which nodes can be watched ---------------------------------------------------------------------------------
