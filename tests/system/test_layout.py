@@ -90,3 +90,23 @@ def test_model_passes_check_urdf(tmp_path):
     proc = subprocess.run(["check_urdf", str(urdf)], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "root Link: base_footprint" in proc.stdout
+
+
+def test_test_nodes_are_executable_in_git():
+    """A clean clone gets the modes git recorded, not this checkout's: rostest answers 'does not exist or is
+    not executable' for a test node committed without its executable bit."""
+    import re
+    if not os.path.isdir(os.path.join(ROOT, ".git")):
+        pytest.skip("not a git checkout")
+    staged = subprocess.run(["git", "-C", ROOT, "ls-files", "-s", "tests/integration", "tests/rostest"],
+                            capture_output=True, text=True, check=True).stdout
+    modes = {line.split("\t")[1].rsplit("/", 1)[-1]: line.split()[0] for line in staged.splitlines()}
+    named = set()
+    for folder in ("tests/integration", "tests/rostest"):
+        for test_file in os.listdir(os.path.join(ROOT, folder)):
+            if test_file.endswith((".test", ".launch")):
+                with open(os.path.join(ROOT, folder, test_file)) as handle:
+                    named.update(re.findall(r'<test\b[^>]*\btype="([^"$]+\.py)"', handle.read()))
+    assert named, "no test nodes found"
+    not_executable = sorted(n for n in named if n in modes and modes[n] != "100755")
+    assert not not_executable, f"test nodes committed without the executable bit: {not_executable}"
