@@ -2,6 +2,7 @@
 """arm_commands suite: commands to arms through controller_manager, bad input, and Gazebo's joint API, each
 judged by the body (ground truth: /gazebo/get_link_state). Robots: arm_commands.test.
 
+- Controller switches asked for while paused wait for the unpause (upstream waits for its realtime loop).
 - Gazebo's joint API: spawn_model -J with -unpause (a paused world, the configuration seen by ground truth),
   set_model_configuration (upstream's answers, limits clamp), get_joint_properties, apply_joint_effort (the
   joint gains the momentum F·T its inertia says, for the duration given) and clear_joint_forces,
@@ -14,6 +15,7 @@ judged by the body (ground truth: /gazebo/get_link_state). Robots: arm_commands.
 import os
 import subprocess
 import sys
+import threading
 import unittest
 
 import rospy
@@ -57,23 +59,33 @@ class ArmCommands(unittest.TestCase):
         clocks = []  # /clock goes on while paused (as Gazebo's): its messages count the simulator's loop going round
         clock_sub = rospy.Subscriber("/clock", Clock, lambda msg: clocks.append(msg.clock.to_sec()), queue_size=100)
         paused_at = sim_now()
-        for ns, group in ARMS.items():  # while paused: every arm held where it stands before time runs
+        switched = {}  # ns: the switch service's answer, once it came
+        def start(ns, group):
+            switched[ns] = cls.managers[ns].switch(start=["joint_state_controller", group])
+        switches = []
+        for ns, group in ARMS.items():
             manager = cls.managers[ns]
             for name in ("joint_state_controller", group):
                 assert manager.load(name, cls.group_params[name]), f"/{ns}: {name} did not load"
-            assert manager.switch(start=["joint_state_controller", group]), f"/{ns}: not started"
-        # a look at a paused world: five /clock messages after the switches (the paused loop sends one every 0.1 s
-        # of its own time), however slowly this node runs; unpaused, fast mode would race ahead meanwhile
+            # as a spawner's: upstream's switch waits for its realtime loop, which runs only once physics does
+            switches.append(threading.Thread(target=start, args=(ns, group), daemon=True))
+            switches[-1].start()
+        # a look at a paused world: five /clock messages after the switches were asked for (the paused loop sends
+        # one every 0.1 s of its own time), however slowly this node runs; unpaused, fast mode would race ahead
         seen = len(clocks)
         wait_for(lambda: len(clocks) >= seen + 5, 30, "five /clock messages while paused")
         clock_sub.unregister()
         cls.was_paused = (paused_at, sim_now())
+        cls.answered_while_paused = dict(switched)
         cls.states = {ns: Latest(f"/{ns}/joint_states", JointState) for ns in ARMS}
         cls.spawn = subprocess.run(
             ["rosrun", "gazebo_ros", "spawn_model", "-urdf", "-param", "/jconf/robot_description", "-model", "jconf",
              "-robot_namespace", "jconf", "-x", str(JCONF[0]), "-y", str(JCONF[1]),
              "-J", "vel_joint", "0.4", "-J", "eff_joint", "-0.3", "-J", "pos_joint", "0.6", "-unpause"],
             capture_output=True, text=True, timeout=60)
+        for thread in switches:
+            thread.join(30)
+        assert switched == {ns: True for ns in ARMS}, f"switches after -unpause answered {switched}"
         cls.configuration = rospy.ServiceProxy("/gazebo/set_model_configuration", SetModelConfiguration)
         cls.properties = rospy.ServiceProxy("/gazebo/get_joint_properties", GetJointProperties)
         cls.effort = rospy.ServiceProxy("/gazebo/apply_joint_effort", ApplyJointEffort)
@@ -151,6 +163,7 @@ class ArmCommands(unittest.TestCase):
         self.assertEqual(self.spawn.returncode, 0, self.spawn.stdout + self.spawn.stderr)
         before, after_wait = self.was_paused
         self.assertEqual(before, after_wait, "sim time ran before spawn_model's -unpause (the world was not paused)")
+        self.assertEqual(self.answered_while_paused, {}, "a controller switch was done while physics was paused")
         wait_for(lambda: sim_now() > after_wait + 0.5, 30, "sim time running after -unpause")
         vel, eff = self.truth.joints("jconf", ["vel_joint", "eff_joint"])
         self.assertAlmostEqual(vel, 0.4, delta=0.005, msg="-J vel_joint 0.4 not where the body is")
