@@ -7,9 +7,12 @@ angles, increments and ranges consistent; no TF extrapolation complaint from amc
 
 Private parameters: ~goals ([[x, y, yaw], ...] in the map frame, which is the world's), ~xy_tolerance (0.25),
 ~avoid (names of moving models, e.g. a walking actor, the body must never drive into: its clearance to each, a
-box of ~avoid_size [depth, width] m about the model's pose, must stay above ~body_radius m whenever the body moves
-towards it (a Gazebo actor walks blind and may walk into a robot that stands); ground truth from
-/gazebo/model_states, whose twists are in the world frame),
+box of ~avoid_size [depth, width] m about the model's pose, must stay above ~body_radius m whenever the body drives
+towards it: both its velocity and its command on ~cmd_topic (/cmd_vel) close on it (a Gazebo actor walks blind and
+may walk into a robot that stands, and then shoves it, its wheels still); ground truth from /gazebo/model_states,
+whose twists are in the world frame). A goal that ends other than SUCCEEDED after a model of ~avoid walked into
+the body meanwhile is sent once more, as a user's mission would, and said so in a FIGURE line: the second must
+succeed,
 ~yaw_tolerance (0.35), ~goal_timeout (sim s, 180), ~truth_topic (the simulator's ground truth,
 /bullet_sim/ground_truth; /gazebo/<model>/ground_truth for a model spawned under the gazebo_ros drop-in),
 ~scan_frame (base_scan). Figures: time to each goal, its error, sim/wall time, RTF.
@@ -24,7 +27,7 @@ import actionlib
 import rospy
 import rostest
 from actionlib_msgs.msg import GoalStatus, GoalStatusArray
-from geometry_msgs.msg import PoseWithCovarianceStamped
+from geometry_msgs.msg import PoseWithCovarianceStamped, Twist
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
 from rosgraph_msgs.msg import Clock, Log
 from sensor_msgs.msg import LaserScan
@@ -56,6 +59,10 @@ class Recorder:
         self.clearance = {name: math.inf for name in self.avoid}
         self.driving_clearance = dict(self.clearance)
         self.driving_moment = {name: "" for name in self.avoid}  # where the smallest driving clearance was
+        self.walked_into = []  # (sim time, name): a model of ~avoid touched the body while the body did not drive
+        self.command = Twist()
+        if self.avoid:
+            rospy.Subscriber(rospy.get_param("~cmd_topic", "/cmd_vel"), Twist, self._command, queue_size=1)
         if self.avoid:
             from gazebo_msgs.msg import ModelStates
 
@@ -71,6 +78,9 @@ class Recorder:
         if robot is None:
             return
         body = msg.pose[names.index(robot)].position
+        heading = msg.pose[names.index(robot)].orientation
+        body_yaw = 2.0 * math.atan2(heading.z, heading.w)
+        commanded = self.command.linear.x
         velocity = msg.twist[names.index(robot)].linear
         depth, width = rospy.get_param("~avoid_size", [0.35, 0.5])
         radius = float(rospy.get_param("~body_radius", 0.1))
@@ -94,14 +104,29 @@ class Recorder:
                 norm = math.hypot(dx, dy)
             closing = (-(velocity.x * away_x + velocity.y * away_y) / norm if norm > 1e-9
                        else math.hypot(velocity.x, velocity.y))
+            # what the robot asked for: a body shoved by a walker moves, but does not drive
+            asked = (-(commanded * (math.cos(body_yaw) * away_x + math.sin(body_yaw) * away_y)) / norm
+                     if norm > 1e-9 else abs(commanded))
+            driving = closing > CLOSING_SPEED and asked > CLOSING_SPEED
             with self.lock:
                 self.clearance[name] = min(self.clearance[name], gap)
-                if closing > CLOSING_SPEED and gap < self.driving_clearance[name]:
+                if gap <= 0.0 and not driving:
+                    self.walked_into.append((rospy.get_time(), name))
+                if driving and gap < self.driving_clearance[name]:
                     self.driving_clearance[name] = gap
                     self.driving_moment[name] = (
                         f"at {rospy.get_time():.2f} s: body ({body.x:.2f}, {body.y:.2f}) moving ({velocity.x:.2f}, "
                         f"{velocity.y:.2f}) m/s, closing at {closing:.2f} m/s on {name} at "
                         f"({pose.position.x:.2f}, {pose.position.y:.2f})")
+
+    def _command(self, msg):
+        with self.lock:
+            self.command = msg
+
+    def walked_into_since(self, since):
+        """The models of ~avoid that touched the body since sim time ``since`` while it did not drive."""
+        with self.lock:
+            return sorted({name for t, name in self.walked_into if t >= since})
 
     def _amcl(self, msg):
         with self.lock:
@@ -152,7 +177,9 @@ class NavigationTest(unittest.TestCase):
         xy_tol, yaw_tol = float(rospy.get_param("~xy_tolerance", 0.25)), float(rospy.get_param("~yaw_tolerance", 0.35))
         timeout = float(rospy.get_param("~goal_timeout", 180.0))
         wall0, sim0 = time.monotonic(), rospy.get_time()
-        for x, y, yaw in goals:
+        attempts = [(goal, 1) for goal in goals]
+        while attempts:
+            (x, y, yaw), attempt = attempts.pop(0)
             goal = MoveBaseGoal()
             goal.target_pose.header.frame_id = "map"
             goal.target_pose.header.stamp = rospy.Time.now()
@@ -181,13 +208,19 @@ class NavigationTest(unittest.TestCase):
                 if belief else ""
 
             status = GoalStatus.to_string(state) if hasattr(GoalStatus, "to_string") else state
+            walkers = self.rec.walked_into_since(started)
+            shoved = f", after {' and '.join(walkers)} walked into the body" if walkers else ""
             figure(f"goal ({x}, {y}, {yaw}): {status} in {took:.1f} s sim ({wall:.1f} s wall), body "
-                   f"{error * 100:.1f} cm and {yaw_error:.3f} rad off{amcl}")
+                   f"{error * 100:.1f} cm and {yaw_error:.3f} rad off{amcl}{shoved}")
+            if state != GoalStatus.SUCCEEDED and walkers and attempt == 1:
+                figure(f"goal ({x}, {y}, {yaw}): sent once more ({' and '.join(walkers)} walked into the body)")
+                attempts.insert(0, ((x, y, yaw), 2))
+                continue
             if len(goals) == 1:  # a batch scenario's goal (tests/rostest/nav_goal.test): for results.jsonl
                 print(f"METRIC time_to_goal_s={took:.3f}\nMETRIC goal_error_m={error:.4f}\n"
                       f"METRIC goal_yaw_error_rad={yaw_error:.4f}", flush=True)
             self.assertEqual(state, GoalStatus.SUCCEEDED, f"goal ({x}, {y}, {yaw}) ended in state {state} after "
-                             f"{took:.1f} s")
+                             f"{took:.1f} s{shoved} (attempt {attempt})")
             self.assertLess(error, xy_tol, f"goal ({x}, {y}): the body is {error:.3f} m from it")
             self.assertLess(yaw_error, yaw_tol, f"goal ({x}, {y}): the body's heading is {yaw_error:.3f} rad off")
         sim_time, wall = rospy.get_time() - sim0, time.monotonic() - wall0
