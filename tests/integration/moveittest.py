@@ -13,27 +13,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from simtest import wait_for
 
 from diffbot_sim.description.urdf_model import parse_urdf
-
-
-def quat_mul(a, b):
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return (aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-            aw * bw - ax * bx - ay * by - az * bz)
-
-
-def rotate(q, v):
-    x, y, z, _ = quat_mul(quat_mul(q, (v[0], v[1], v[2], 0.0)), (-q[0], -q[1], -q[2], q[3]))
-    return (x, y, z)
-
-
-def rpy_quat(r, p, y):
-    cr, sr, cp, sp, cy, sy = (math.cos(r / 2), math.sin(r / 2), math.cos(p / 2), math.sin(p / 2),
-                              math.cos(y / 2), math.sin(y / 2))
-    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy,
-            cr * cp * cy + sr * sp * sy)
+from diffbot_sim.transforms import compose, rpy_quaternion
 
 
 def angle_between(a, b):
@@ -58,9 +38,7 @@ class Body:
             joint = next((j for j in self.model.joints.values() if j.child == link), None)
             if joint is None or joint.type != "fixed":
                 return link, offset, turn
-            q = rpy_quat(*joint.rpy)
-            offset = tuple(a + b for a, b in zip(joint.xyz, rotate(q, offset)))
-            turn = quat_mul(q, turn)
+            offset, turn = compose((tuple(joint.xyz), rpy_quaternion(*joint.rpy)), (offset, turn))
             link = joint.parent
 
     def pose(self, link):
@@ -69,9 +47,7 @@ class Body:
         resp = self.link_state(f"{self.model_name}::{kept}", "")
         assert resp.success, f"get_link_state {self.model_name}::{kept}: {resp.status_message}"
         p, q = resp.link_state.pose.position, resp.link_state.pose.orientation
-        q = (q.x, q.y, q.z, q.w)
-        d = rotate(q, offset)
-        return (p.x + d[0], p.y + d[1], p.z + d[2]), quat_mul(q, turn)
+        return compose(((p.x, p.y, p.z), (q.x, q.y, q.z, q.w)), (offset, turn))
 
 
 def wait_for_move_group(timeout=120.0):
@@ -137,5 +113,5 @@ def settled_pose(body, link, band=0.0005, window=0.3, timeout=30.0):
     return tuple(reading[:3]), tuple(reading[3:])
 
 
-__all__ = ["Body", "angle_between", "fk", "quat_mul", "rotate", "settled_pose", "state_valid", "tf_pose",
+__all__ = ["Body", "angle_between", "fk", "settled_pose", "state_valid", "tf_pose",
            "wait_for", "wait_for_move_group"]
