@@ -20,7 +20,7 @@ import rostest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from moveittest import Body, angle_between, fk, settled_pose, state_valid, tf_pose, wait_for_move_group
-from simtest import wait_for
+from simtest import figure, wait_for
 
 ARM = ["shoulder_yaw_joint", "shoulder_pitch_joint", "elbow_joint", "wrist_joint"]
 TOOL = "gripper_tcp_link"
@@ -28,10 +28,6 @@ MODEL = "diffbot_arm"
 FRAME = "odom"
 REACHED = 0.01  # m: the tool's ground truth within this of the planned pose
 TURNED = 0.05  # rad
-
-
-def figure(text):
-    print(f"FIGURE {text}", flush=True)
 
 
 class MoveItArm(unittest.TestCase):

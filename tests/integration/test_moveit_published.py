@@ -19,6 +19,7 @@ import rostest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from moveittest import Body, fk, settled_pose, tf_pose, wait_for_move_group
+from simtest import figure
 
 ARM = ["joint1", "joint2", "joint3", "joint4"]
 TOOL = "end_effector_link"
@@ -43,10 +44,6 @@ print("RESULT " + json.dumps({"python": sys.executable, "joints": joints, "plann
       "points": len(plan.joint_trajectory.points), "jacobian_type": type(jacobian).__name__,
       "jacobian_shape": list(numpy.shape(jacobian)), "jacobian": numpy.asarray(jacobian).tolist()}))
 """
-
-
-def figure(text):
-    print(f"FIGURE {text}", flush=True)
 
 
 class MoveItPublished(unittest.TestCase):
