@@ -9,7 +9,7 @@ Private parameters: ~goals ([[x, y, yaw], ...] in the map frame, which is the wo
 ~avoid (names of moving models, e.g. a walking actor, the body must never drive into: its clearance to each, a
 box of ~avoid_size [depth, width] m about the model's pose, must stay above ~body_radius m whenever the body drives
 towards it: both its velocity and its command on ~cmd_topic (/cmd_vel) close on it (a Gazebo actor walks blind and
-may walk into a robot that stands, and then shoves it, its wheels still); ground truth from /gazebo/model_states,
+may walk into, and through, a robot that stands: the body sees it all around and may give up); ground truth from /gazebo/model_states,
 whose twists are in the world frame). A goal that ends other than SUCCEEDED after a model of ~avoid walked into
 the body meanwhile is sent once more, as a user's mission would, and said so in a FIGURE line: the second must
 succeed,

@@ -98,6 +98,8 @@ class World:
         robot = Robot(self.client, body, model, *root_pose, frames, self.time_step, self.landing.erp)
         robot.gravity = self.gravity
         self.robots.append(robot)
+        for box in self._boxes:
+            self._pass_through(box, robot.body)
         self.lift_out(robot)
         self.laser_retro.update(robot.laser_retro())
         self.ray_link.record("replay", "load_robot", (urdf_text, model, position, yaw, orientation), [body])
@@ -134,12 +136,22 @@ class World:
 
     def add_kinematic_box(self, size, pose):
         """A box of ``size`` (x, y, z) [m] centred at ``pose`` ((x, y, z), (qx, qy, qz, qw)) that forces never
-        move (mass 0) and :meth:`move_body` places (an actor): rays, cameras and robots meet it where it was put.
-        Returns its PyBullet id."""
+        move (mass 0) and :meth:`move_body` places (an actor): rays and cameras meet it where it was put, robots
+        pass through it. Gazebo's actors collide with nothing (its actor tutorial: they "won't fall due to gravity
+        or collide with other objects"); a solid box walking its script blind would shove a robot that stopped for
+        it. Returns its PyBullet id."""
         uid = building.kinematic_box(self.client, size, pose)
         self._boxes.append(uid)
+        for robot in self.robots:
+            self._pass_through(uid, robot.body)
         self.ray_link.record("replay", "add_kinematic_box", (size, pose), [uid])
         return uid
+
+    def _pass_through(self, box, body):
+        """No contact between ``box`` and any link of ``body``. A pair filter, not a group mask: Bullet's ray
+        tests honour masks but not pairs, so rays still meet the box."""
+        for link in range(-1, pybullet.getNumJoints(body, physicsClientId=self.client)):
+            pybullet.setCollisionFilterPair(box, body, -1, link, 0, physicsClientId=self.client)
 
     def move_body(self, uid, pose):
         """Place body ``uid`` (its base frame) at ``pose``."""

@@ -39,8 +39,8 @@ class Actor:
 
     def _body_pose(self):
         """Where the box goes: on the actor, except while a script waits for its first frame (the first 1/30 s):
-        Gazebo's actor stands at its ``<pose>`` until then, touching nothing (it has no body), and a box there
-        would shove what stands at that pose (at 1/240 s steps a robot at the origin was pushed 4.7 cm)."""
+        Gazebo's actor stands at its ``<pose>`` until then with no body, and a box there would be in the rays of
+        a laser standing at that pose (a robot spawned at the origin saw it at 1/240 s steps)."""
         if self.script is not None and self.script.about_to_move:
             return PARKED
         return self._box_pose()

@@ -118,3 +118,32 @@ def test_the_box_faces_the_walking_direction(world):
     actors.before_step(0.1)
     # facing +y, along x the box is as wide as a person (0.5 m), not as deep (0.35 m)
     assert hit_x(world) == pytest.approx(-PERSON_SIZE[1] / 2, abs=1e-3)
+
+
+CRATE_ROBOT = """<robot name="crate"><link name="base_link">
+  <inertial><mass value="5"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+  <collision><geometry><box size="0.3 0.3 0.2"/></geometry></collision></link></robot>"""
+
+
+def test_a_robot_in_the_walkers_path_is_not_shoved_and_rays_still_see_the_walker():
+    """Gazebo's actors collide with nothing: a robot standing where a script walks is walked through, not shoved
+    (a solid box shoved a robot that had stopped for a walker 0.6 m, and amcl lost it); lasers still see it."""
+    from diffbot_sim.description.urdf_model import parse_urdf
+    import pybullet
+
+    world = World(1.0 / 240.0)
+    try:
+        actors = Actors(world, [description(SCRIPTED)], seed=0, robots=lambda: [])
+        robot = world.load_robot(CRATE_ROBOT, parse_urdf(CRATE_ROBOT, "crate.urdf"), position=(2.0, 0.0, 0.0))
+        now, seen = 0.0, []
+        while now < 4.0:
+            now += world.time_step
+            actors.before_step(now)
+            world.step()
+            if 1.9 < actors.actors[0].pose[0][0] < 2.1:  # the walker inside the robot's box
+                seen.append(hit_x(world, z=1.5))  # above the robot: the walker's front face
+        (x, y, _), _ = pybullet.getBasePositionAndOrientation(robot.body, physicsClientId=world.client)
+        assert math.hypot(x - 2.0, y) < 0.005, f"the walker shoved the robot to ({x:.3f}, {y:.3f})"
+        assert seen and all(h is not None and 1.7 < h < 1.95 for h in seen), seen
+    finally:
+        world.close()
