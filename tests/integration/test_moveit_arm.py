@@ -3,7 +3,7 @@
 demo_gazebo.launch: manipulator.launch + move_group on the simulator's controllers), driven through
 moveit_commander as a user's script drives it. Each executed plan is judged by the body: the tool's ground truth
 (gripper_tcp_link through its kept parent, /gazebo/get_link_state) against the pose MoveIt planned for (its own
-forward kinematics of the plan's last point), and TF agreeing with the body. A joint goal; a pose goal (TRAC-IK);
+forward kinematics of the plan's last point), and TF agreeing with the body. A joint goal; a pose goal (LMA IK);
 compute_ik/compute_fk; a goal in collision refused (nothing moves); a plan around an obstacle put on the straight
 way (the tool never inside it by ground truth). Run at real time and in fast mode (rostest arg real_time): in
 fast mode MoveIt's execution monitoring (allowed_execution_duration_scaling, goal tolerances) must hold in sim
@@ -116,7 +116,7 @@ class MoveItArm(unittest.TestCase):
         (pose.pose.position.x, pose.pose.position.y, pose.pose.position.z) = position
         (pose.pose.orientation.x, pose.pose.orientation.y, pose.pose.orientation.z,
          pose.pose.orientation.w) = orientation
-        # compute_ik answers with a state whose FK is the pose (TRAC-IK)
+        # compute_ik answers with a state whose FK is the pose
         request = PositionIKRequest(group_name="arm", ik_link_name=TOOL, pose_stamped=pose, avoid_collisions=True)
         request.timeout = rospy.Duration(1.0)
         answer = rospy.ServiceProxy("/compute_ik", GetPositionIK)(ik_request=request)

@@ -9,13 +9,12 @@ Private parameters: ~goals ([[x, y, yaw], ...] in the map frame, which is the wo
 ~avoid (names of moving models, e.g. a walking actor, the body must never drive into: its clearance to each, a
 box of ~avoid_size [depth, width] m about the model's pose, must stay above ~body_radius m whenever the body drives
 towards it: both its velocity and its command on ~cmd_topic (/cmd_vel) close on it (a Gazebo actor walks blind and
-may walk into, and through, a robot that stands: the body sees it all around and may give up); ground truth from /gazebo/model_states,
-whose twists are in the world frame). A goal that ends other than SUCCEEDED after a model of ~avoid walked into
-the body meanwhile is sent once more, as a user's mission would, and said so in a FIGURE line: the second must
-succeed,
-~yaw_tolerance (0.35), ~goal_timeout (sim s, 180), ~truth_topic (the simulator's ground truth,
-/bullet_sim/ground_truth; /gazebo/<model>/ground_truth for a model spawned under the gazebo_ros drop-in),
-~scan_frame (base_scan). Figures: time to each goal, its error, sim/wall time, RTF.
+may walk into, and through, a robot that stands: the body then sees it all around and may give up); ground truth
+from /gazebo/model_states, whose twists are in the world frame). A goal that ends other than SUCCEEDED after a
+model of ~avoid walked into the body meanwhile is sent once more, as a user's mission would, and said so in a
+FIGURE line: the second must succeed, ~yaw_tolerance (0.35), ~goal_timeout (sim s, 180), ~truth_topic (the
+simulator's ground truth, /bullet_sim/ground_truth; /gazebo/<model>/ground_truth for a model spawned under the
+gazebo_ros drop-in), ~scan_frame (base_scan). Figures: time to each goal, its error, sim/wall time, RTF.
 """
 import math
 import sys

@@ -9,10 +9,12 @@ is attached to the hand while carried. The base drives as in the plain variant (
 Parameters: those of the plain variant, and ``~planning_time`` (s, default 5) and ``~planning_attempts``
 (default 3) per arm step. Exit status: 0 when every step succeeded, 1 otherwise (the step and why in one line).
 """
+import functools
 import sys
 
 import rospy
 
+from diffbot_sim.check import stillness
 from diffbot_sim.check.arm_check import forward_kinematics
 from diffbot_sim.control import pick_place as pp
 from diffbot_sim.description.urdf_model import parse_urdf
@@ -26,13 +28,18 @@ HELD = "held_box"  # the attached collision object while the box is carried
 #: The links the held box may touch (the fingers squeeze it, the palm is next to it).
 TOUCH_LINKS = ["left_finger_link", "right_finger_link", "wrist_link", TOOL]
 SERVER_WAIT = 60.0  # s (wall) for move_group's action servers
+#: Before an arm step is planned the arm must hold within STILL_BAND rad over STILL_WINDOW s of joint_states'
+#: stamps (MoveIt refuses a plan whose start is more than 0.01 rad from the state at execution: after the box is
+#: let go on the table the shoulder swung 0.012 rad in the 0.3 s between planning and execution); at most
+#: STILL_WAIT s of sim time, then the step is planned anyway.
+STILL_BAND, STILL_WINDOW, STILL_WAIT = 0.002, 0.2, 5.0
 ATTACH_MARGIN = 0.005  # m the attached box is smaller than the box
 
 
 class MoveItArm:
     """moveit_commander's side: the planning scene, the arm and the gripper groups."""
 
-    def __init__(self, scene, planning_time, attempts):
+    def __init__(self, scene, planning_time, attempts, joints):
         import moveit_commander
 
         moveit_commander.roscpp_initialize([sys.argv[0]])
@@ -46,6 +53,8 @@ class MoveItArm:
         self.arm.set_planning_time(planning_time)
         self.arm.set_num_planning_attempts(attempts)
         self.scene = scene
+        self.joints = joints
+        self.arm_joints = self.arm.get_active_joints()
         self.plan_times = []
 
     def add_tables(self):
@@ -67,9 +76,14 @@ class MoveItArm:
         self.scene_if.remove_world_object(HELD)
 
     def _run(self, group, what):
-        """Plan the group's target and execute the plan; raises StepFailed with MoveIt's error code."""
+        """Plan the group's target, from the arm at rest, and execute the plan; raises StepFailed with MoveIt's
+        error code."""
         from moveit_msgs.msg import MoveItErrorCodes
 
+        still, why = self.joints.wait_still(self.arm_joints, STILL_BAND, STILL_WINDOW, STILL_WAIT)
+        if not still:
+            rospy.logwarn(f"pick_place: {what}: the arm did not come to rest within {STILL_WAIT} s ({why}); "
+                          f"planning anyway")
         ok, plan, seconds, error = group.plan()
         if not ok:
             raise StepFailed(f"{what}: no plan ({_code_name(error.val, MoveItErrorCodes)})")
@@ -129,29 +143,56 @@ def _code_name(value, codes):
     return str(value)
 
 
-def _finger_reader():
-    """A function returning left_finger_joint's latest position from joint_states."""
-    import threading
+class JointWatch:
+    """joint_states as this node needs them: the latest position of each joint, and the last second of samples
+    (stamped in sim time) for :meth:`wait_still`."""
 
-    from sensor_msgs.msg import JointState
+    KEEP = 1.0  # s of samples kept
 
-    latest = {}
-    lock = threading.Lock()
+    def __init__(self):
+        import collections
+        import threading
 
-    def keep(msg):
-        with lock:
-            latest.update(zip(msg.name, msg.position))
-    rospy.Subscriber("joint_states", JointState, keep, queue_size=5)
+        from sensor_msgs.msg import JointState
 
-    def read():
+        self._latest = {}
+        self._samples = collections.deque()  # (stamp, {name: position})
+        self._lock = threading.Lock()
+        rospy.Subscriber("joint_states", JointState, self._keep, queue_size=5)
+
+    def _keep(self, msg):
+        stamp = msg.header.stamp.to_sec()
+        positions = dict(zip(msg.name, msg.position))
+        with self._lock:
+            self._latest.update(positions)
+            self._samples.append((stamp, positions))
+            while self._samples and self._samples[0][0] < stamp - self.KEEP:
+                self._samples.popleft()
+
+    def position(self, joint):
+        """``joint``'s latest position (waits up to 5 s of sim time for one)."""
         deadline = rospy.get_time() + 5.0
         while not rospy.is_shutdown() and rospy.get_time() < deadline:
-            with lock:
-                if FINGER in latest:
-                    return latest[FINGER]
+            with self._lock:
+                if joint in self._latest:
+                    return self._latest[joint]
             rospy.sleep(0.02)
-        raise StepFailed(f"no {FINGER} on joint_states")
-    return read
+        raise StepFailed(f"no {joint} on joint_states")
+
+    def wait_still(self, joints, band, window, timeout):
+        """(True, None) once ``joints`` have held within ``band`` over ``window`` s of message stamps
+        (:func:`diffbot_sim.check.stillness.held_still`), else (False, why) after ``timeout`` s of sim time."""
+        deadline, why = rospy.get_time() + timeout, "no joint_states"
+        while not rospy.is_shutdown():
+            with self._lock:
+                samples = [(t, [p[j] for j in joints]) for t, p in self._samples if all(j in p for j in joints)]
+            still, why = stillness.held_still(samples, band, window)
+            if still:
+                return True, None
+            if rospy.get_time() >= deadline:
+                return False, why
+            rospy.sleep(0.02)
+        return False, "shut down"
 
 
 def run(Robot, BaseStepFailed, scene_from_params):
@@ -168,13 +209,14 @@ def run(Robot, BaseStepFailed, scene_from_params):
         origins = {link: pose[0] for link, pose in forward_kinematics(model, {}).items()}
         geometry = pp.arm_geometry(origins)
         robot = Robot(step_timeout)
-        moveit = MoveItArm(scene, planning_time, attempts)
+        joints = JointWatch()
+        moveit = MoveItArm(scene, planning_time, attempts, joints)
         steps = pp.moveit_steps(scene, robot.current_pose())
     except (DiffbotSimError, KeyError, ValueError, BaseStepFailed, StepFailed, RuntimeError) as err:
         rospy.logfatal(f"pick_place: {err}")
         return 1
     rospy.loginfo("pick_place (MoveIt): the steps:\n" + "\n".join(pp.describe(steps)))
-    finger = _finger_reader()
+    finger = functools.partial(joints.position, FINGER)
     moveit.add_tables()
     try:
         for index, step in enumerate(steps, 1):

@@ -128,8 +128,9 @@ CRATE_ROBOT = """<robot name="crate"><link name="base_link">
 def test_a_robot_in_the_walkers_path_is_not_shoved_and_rays_still_see_the_walker():
     """Gazebo's actors collide with nothing: a robot standing where a script walks is walked through, not shoved
     (a solid box shoved a robot that had stopped for a walker 0.6 m, and amcl lost it); lasers still see it."""
-    from diffbot_sim.description.urdf_model import parse_urdf
     import pybullet
+
+    from diffbot_sim.description.urdf_model import parse_urdf
 
     world = World(1.0 / 240.0)
     try:
