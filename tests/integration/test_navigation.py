@@ -59,6 +59,9 @@ class Recorder:
         self.driving_clearance = dict(self.clearance)
         self.driving_moment = {name: "" for name in self.avoid}  # where the smallest driving clearance was
         self.walked_into = []  # (sim time, name): a model of ~avoid touched the body while the body did not drive
+        # names of ~avoid that walked over the body (the overlap began while it did not drive) and still overlap it:
+        # Gazebo's actors pass through robots, and the body's moves while one stands over it are not driving into it
+        self.walked_over = set()
         self.command = Twist()
         if self.avoid:
             rospy.Subscriber(rospy.get_param("~cmd_topic", "/cmd_vel"), Twist, self._command, queue_size=1)
@@ -70,7 +73,8 @@ class Recorder:
     def _models(self, msg):
         """The body's clearance to each model of ~avoid (their boxes), kept at its smallest: over all time, and
         over the moments the body itself was closing on the model (a Gazebo actor walks its script blind, through
-        anything; a walker that walks into a robot standing or backing away is not the robot's collision)."""
+        anything; a walker that walks into a robot standing or backing away is not the robot's collision, nor are
+        the body's moves while the walker stands over it)."""
         names = list(msg.name)
         robot = next((n for n in names if n not in self.avoid and msg.pose[names.index(n)].position.z < 0.5
                       and n not in self.static_models), None)
@@ -109,9 +113,12 @@ class Recorder:
             driving = closing > CLOSING_SPEED and asked > CLOSING_SPEED
             with self.lock:
                 self.clearance[name] = min(self.clearance[name], gap)
-                if gap <= 0.0 and not driving:
+                if gap > 0.0:
+                    self.walked_over.discard(name)
+                elif not driving:
                     self.walked_into.append((rospy.get_time(), name))
-                if driving and gap < self.driving_clearance[name]:
+                    self.walked_over.add(name)
+                if driving and gap < self.driving_clearance[name] and name not in self.walked_over:
                     self.driving_clearance[name] = gap
                     self.driving_moment[name] = (
                         f"at {rospy.get_time():.2f} s: body ({body.x:.2f}, {body.y:.2f}) moving ({velocity.x:.2f}, "
