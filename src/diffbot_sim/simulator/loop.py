@@ -129,6 +129,7 @@ class Simulator:
         self._sensor_pubs = None  # the sensor plugins' publishers (NodeSync), rebuilt when robots change
         self._next_commander_scan = 0.0  # wall time of the next look at who publishes commands (NodeSync)
         self._rtf_mark = None  # (wall, sim, waited) at the last achieved-RTF report
+        self._paced_for_lag = False  # fast mode paced at real time for a lagging node (_lagging_node)
 
     def publishers(self):
         """Every publisher the loop writes to (SubscriberLinks tunes and batches their connections)."""
@@ -314,9 +315,10 @@ class Simulator:
                 self.wake.clear()
                 continue
             limit = MAX_BATCH_STEPS
-            if cfg.real_time:
+            if cfg.real_time or self._lagging_node():
                 dt = cfg.time_step
-                limit, target = self._real_time_room(time.monotonic())
+                factor = cfg.real_time_factor if cfg.real_time else 1.0
+                limit, target = self._real_time_room(time.monotonic(), factor)
                 if limit == 0:
                     # Sleep until the next thing due, or until a command wakes us. Publishing and control,
                     # not stepping, set the wake rate, so CPU stays low.
@@ -324,7 +326,7 @@ class Simulator:
                     # Wake at the step that reaches ``due`` (steps land on multiples of dt), not at ``due``
                     # itself: waking between steps would only find nothing to do and sleep again.
                     step_at = self._step_reaching(due)
-                    wait = (max(step_at, self.sim_time + dt) - target) / cfg.real_time_factor
+                    wait = (max(step_at, self.sim_time + dt) - target) / factor
                     if self.wake.wait(min(max(wait, 0.0), 0.1)):
                         # A command woke us: it is taken now, and applied by the plugins' before_step at the
                         # next step, once (a plugin's step work is not repeated: PyBullet adds up torques set
@@ -334,14 +336,25 @@ class Simulator:
                     continue
             self._step_once(limit)
 
-    def _real_time_room(self, wall):
-        """In real time, at wall-clock ``wall``: (how many steps are due now, at most MAX_BATCH_STEPS; 0 to wait,
-        the sim time pacing wants). Sim time that fell behind by more than MAX_CATCH_UP wall seconds (a stall:
-        a spawn, a slow service, a busy machine) is not made up: pacing starts again from here (``_rebase``)."""
-        cfg, dt = self.cfg, self.cfg.time_step
-        target = self.sim0 + (wall - self.wall0) * cfg.real_time_factor
-        if target - self.sim_time > MAX_CATCH_UP * cfg.real_time_factor + dt:
-            self.wall0, self.sim0 = wall - dt / cfg.real_time_factor, self.sim_time
+    def _lagging_node(self):
+        """Fast mode with a node in the loop dropped for lagging and expected back (:meth:`NodeSync.lagging`): sim
+        time is then paced at real time until it is taken back. Pacing is re-anchored when that begins (sim time
+        ran ahead of the wall clock until then)."""
+        lagging = self.cfg.wait_for_nodes and self.sync.lagging()
+        if lagging and not self._paced_for_lag:
+            self._rebase()
+        self._paced_for_lag = lagging
+        return lagging
+
+    def _real_time_room(self, wall, factor):
+        """Paced at ``factor`` x real time, at wall-clock ``wall``: (how many steps are due now, at most
+        MAX_BATCH_STEPS; 0 to wait, the sim time pacing wants). Sim time that fell behind by more than MAX_CATCH_UP
+        wall seconds (a stall: a spawn, a slow service, a busy machine) is not made up: pacing starts again from
+        here (``_rebase``)."""
+        dt = self.cfg.time_step
+        target = self.sim0 + (wall - self.wall0) * factor
+        if target - self.sim_time > MAX_CATCH_UP * factor + dt:
+            self.wall0, self.sim0 = wall - dt / factor, self.sim_time
             target = self.sim_time + dt
         due = int((target - self.sim_time) / dt + 1e-9)
         return max(0, min(MAX_BATCH_STEPS, due)), target

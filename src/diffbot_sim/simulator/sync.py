@@ -26,9 +26,11 @@ one that published on a sensor topic, until every node that was subscribed to it
 A node is found by the subscriber's caller id (the master's ``lookupNode``, then its own ``getPid``); one on
 another host, or one matching ``~wait_for_nodes_ignore`` (rviz by default: it renders all the time), is not
 waited for. A node that keeps the simulator waiting longer than ``~wait_for_nodes_timeout`` wall seconds at
-one message is named in one warning and not waited for while it stays busy: the lag is bounded. It is waited
-for again once it is seen idle (it caught up: amcl, gmapping and move_base are busy for seconds while they start,
-and dropped for good they then lagged the whole run) or subscribes anew; after MAX_DROPS drops, only anew.
+one message is named in one warning and not waited for while it stays busy: the lag is bounded, and meanwhile
+sim time runs no faster than real time (:meth:`NodeSync.lagging`), so the node misses no more than it would at
+real time. It is waited for again once it is seen idle (it caught up: amcl, gmapping and move_base are busy for
+seconds while they start, and dropped for good they then lagged the whole run) or subscribes anew; after
+MAX_DROPS drops, only anew.
 While it waits, the loop keeps serving requests (services, spawns, resets). A reset first waits until its
 caller's subscriptions to the simulator's topics are connected (:meth:`NodeSync.connect_first`).
 """
@@ -311,6 +313,12 @@ class NodeSync:
             time.sleep(POLL)
             serve()
         self.waited += time.monotonic() - started
+
+    def lagging(self):
+        """Whether a node dropped for outlasting the timeout is alive and expected back (it has drops left): while
+        one is, the loop runs sim time no faster than real time, so that node falls no further behind than it would
+        at real time (gmapping, busy 5 s with its first scan, missed some 20 s of a fast tour and mapped it askew)."""
+        return any(node.dropped and node.drops < MAX_DROPS and node.alive() for node in self.nodes.values())
 
     def take_back_idle(self, publishers, now_wall):
         """Wait again for the nodes in this hold that were dropped and are idle now: they have caught up (a node

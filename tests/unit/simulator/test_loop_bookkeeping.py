@@ -246,10 +246,36 @@ def test_real_time_pacing_does_not_race_to_make_up_a_stall():
     pacing goes on from there. A lag under MAX_CATCH_UP (a late wake-up) is made up."""
     from diffbot_sim.simulator.loop import MAX_CATCH_UP
     sim = bare_loop()
-    assert sim._real_time_room(0.0035)[0] == 3
+    assert sim._real_time_room(0.0035, 1.0)[0] == 3
     sim.steps = 3
-    assert sim._real_time_room(0.6035)[0] == 1
+    assert sim._real_time_room(0.6035, 1.0)[0] == 1
     sim.steps = 4
-    assert sim._real_time_room(0.6045)[0] == 1  # and on at the wall clock's pace, from the stall's end
-    assert sim._real_time_room(0.6045 + MAX_CATCH_UP / 2)[0] == 1 + round(MAX_CATCH_UP / 2 / 0.001)
-    assert bare_loop()._real_time_room(0.0005)[0] == 0  # not yet: wait
+    assert sim._real_time_room(0.6045, 1.0)[0] == 1  # and on at the wall clock's pace, from the stall's end
+    assert sim._real_time_room(0.6045 + MAX_CATCH_UP / 2, 1.0)[0] == 1 + round(MAX_CATCH_UP / 2 / 0.001)
+    assert bare_loop()._real_time_room(0.0005, 1.0)[0] == 0  # not yet: wait
+
+
+def test_fast_mode_is_paced_at_real_time_while_a_lagging_node_is_expected_back():
+    """A node in the loop dropped for outlasting ~wait_for_nodes_timeout (gmapping busy 5 s with its first scan):
+    fast mode runs at real time until it is taken back, re-anchored where it begins, not held back to where the
+    wall clock would have put a real-time run from the start."""
+    from types import SimpleNamespace
+
+    sim = bare_loop()
+    sim.cfg.wait_for_nodes = True
+    lagging = [False]
+    sim.sync = SimpleNamespace(lagging=lambda: lagging[0])
+    sim._paced_for_lag = False
+    sim.steps = 5000  # 5 s of sim time run fast, in far less wall time
+    assert not sim._lagging_node()
+    lagging[0] = True
+    assert sim._lagging_node() and sim.sim0 == 5.0  # re-anchored at the sim time now
+    wall = sim.wall0
+    assert sim._real_time_room(wall + 0.0035, 1.0)[0] == 3  # real time from here
+    sim.wall0 = -1.0
+    assert sim._lagging_node() and sim.wall0 == -1.0  # still lagging: not re-anchored again
+    lagging[0] = False
+    assert not sim._lagging_node()
+    sim.cfg.wait_for_nodes = False
+    lagging[0] = True
+    assert not sim._lagging_node()  # ~wait_for_nodes off: nobody is waited for, nobody lags

@@ -304,6 +304,7 @@ def test_a_dropped_node_is_waited_for_again_once_it_is_idle_at_most_max_drops_ti
         node_sync.take_back_idle([scan], 0.0)
         assert starting.dropped == (drop == sync.MAX_DROPS)  # idle: waited for again, but not after MAX_DROPS
     assert "until it subscribes again" in node_sync.warnings[-1][1]
+    assert not node_sync.lagging()  # dropped for good: fast mode is not held to real time for it
     starting.is_busy = True
     sent(node_sync, scan)
     assert node_sync.pending([scan], 0.0) == []  # dropped for good: not waited for while busy
@@ -544,3 +545,22 @@ def test_a_reset_waits_until_its_callers_subscriptions_are_connected(node_sync, 
     node_sync.connect_first(request("/other"), [odom, scan])  # subscribed, never connected: named, goes on
     (key, text), = node_sync.warnings
     assert key == "sync-connect:/other" and "/odom" in text
+
+
+def test_a_node_dropped_and_expected_back_is_lagging_until_taken_back(node_sync):
+    """While a dropped node is expected back (alive, drops left), the loop paces fast mode at real time."""
+    node_sync.timeout = 0.0
+    scan = Pub()
+    starting, = watch(node_sync, Node("/slam_gmapping", busy=True))
+    scan.impl.connections.append(Conn("/slam_gmapping"))
+    assert not node_sync.lagging()
+    sent(node_sync, scan)
+    served = []
+    node_sync.wait([scan], lambda: served.append(1), lambda: len(served) > 100)
+    assert starting.dropped and node_sync.lagging()
+    starting.is_alive = False
+    assert not node_sync.lagging()  # it died: nobody to wait for
+    starting.is_alive, starting.is_busy = True, False
+    sent(node_sync, scan)
+    node_sync.take_back_idle([scan], 0.0)
+    assert not starting.dropped and not node_sync.lagging()
