@@ -35,7 +35,7 @@ from diffbot_sim.simulator.gazebo_models import (
     WorldModelEntity,
 )
 from diffbot_sim.simulator.joint_services import JointServices
-from diffbot_sim.simulator.loop import CALL_TIMEOUT
+from diffbot_sim.simulator.loop_requests import CALL_TIMEOUT
 from diffbot_sim.transforms import compose
 
 #: Time a spawn may take on the loop (mesh conversion of a large model), before the caller gives up.

@@ -3,7 +3,6 @@ what is due and publishes /clock and /tf (rospy). Subscriber and service callbac
 (``call``/``post``); it knows no plugin by name."""
 import math
 import sys
-import threading
 import time
 
 import rospy
@@ -15,14 +14,13 @@ from diffbot_sim.config import wants_ray_process
 from diffbot_sim.messages import common as ros_msgs
 from diffbot_sim.physics import World
 from diffbot_sim.plugins.base import next_due, publisher
+from diffbot_sim.simulator.loop_requests import LoopRequests
 from diffbot_sim.simulator.subscriber_links import SubscriberLinks
 from diffbot_sim.simulator.sync import NodeSync
 from diffbot_sim.simulator.throttle import Throttle
 
 #: Wall seconds between two reports of the achieved real-time factor in fast mode.
 RTF_REPORT_PERIOD = 30.0
-#: Wall seconds a service request may wait for the loop (gazebo_ros's deleteModel waits 60 s for the world).
-CALL_TIMEOUT = 60.0
 #: Wall seconds the loop's thread keeps the interpreter lock before handing it to a waiting rospy thread
 #: (Python's default is 5 ms). PyBullet's calls keep the lock, so in fast mode the loop holds it all the time
 #: but for these hand-overs; a service call or a new connection crosses a dozen of them (accept, header,
@@ -93,16 +91,14 @@ class RobotRuntime:
             plugin.start(now)
 
 
-class Simulator:
+class Simulator(LoopRequests):
     """The single-threaded loop: apply commands -> step -> publish, paced to the wall clock or not."""
 
     def __init__(self, cfg):
+        LoopRequests.__init__(self)
         self.cfg = cfg
-        self.wake = threading.Event()
         self.throttle = Throttle(5.0)
         self.paused = False
-        self._requests = []
-        self._requests_lock = threading.Lock()
         self.steps = 0
         self._time_base, self._steps_base = 0.0, 0  # sim time at the step count where the step last changed
         self.world = World(cfg.time_step, cfg.gravity, gui=cfg.gui,
@@ -143,55 +139,6 @@ class Simulator:
         if self.throttle.ready(key, time.monotonic()):
             held = self.throttle.take_suppressed(key)
             rospy.logwarn(text + (f" ({held} more since the last warning)" if held else ""))
-
-    # -- requests from rospy's threads (services, subscribers): the loop does the work -----------------
-    def call(self, action, timeout=CALL_TIMEOUT):
-        """Run ``action()`` on the loop's thread (the only one that touches physics and plugins) and return
-        its result; an exception it raises is raised here. Works while paused.
-
-        A request the loop has not begun within ``timeout`` wall seconds is withdrawn (it never runs later:
-        the caller's failure answer stays true); one it has begun is waited for to its end.
-
-        Raises:
-            rospy.ServiceException: the loop did not get to it within ``timeout`` wall seconds.
-        """
-        done = threading.Event()
-        box = {}
-        state_lock = threading.Lock()
-
-        def run():
-            with state_lock:
-                if box.get("withdrawn"):
-                    return
-                box["begun"] = True
-            try:
-                box["result"] = action()
-            except Exception as err:  # handed back to the caller's thread, raised there
-                box["error"] = err
-            done.set()
-        self.post(run)
-        if not done.wait(timeout):
-            with state_lock:
-                box["withdrawn"] = not box.get("begun")
-            if box["withdrawn"]:
-                raise rospy.ServiceException(f"the simulator loop did not get to the request within {timeout:g} s "
-                                             "(withdrawn: it will not run)")
-            done.wait()
-        if "error" in box:
-            raise box["error"]
-        return box.get("result")
-
-    def post(self, action):
-        """Queue ``action()`` for the loop without waiting (a subscriber callback)."""
-        with self._requests_lock:
-            self._requests.append(action)
-        self.wake.set()
-
-    def _handle_requests(self):
-        with self._requests_lock:
-            requests, self._requests = self._requests, []
-        for action in requests:
-            action()
 
     def pause(self):
         self.paused = True

@@ -38,9 +38,10 @@ def rays_around(center, count=720, height=0.15, length=4.0):
 def assert_same(world, position, rotation, directions, near, far, key=0):
     here = world.ray_batch(*rays_along(position, rotation, directions, near, far))
     there = world.cast_answer(world.cast_later(key, directions, near, far, position, rotation), wait=True)
-    # Within 0.1 mm: Bullet casts against a cylinder iteratively (GJK), and a pose read back from one world and
-    # set in the other can differ in its last bit (measured: 8 of 720 rays 34 um apart on a drum-shaped base).
-    np.testing.assert_allclose(there[0] * (far - near), here[0] * (far - near), atol=1e-4)
+    # Within 0.25 mm (a laser resolves 1 cm at best): Bullet casts against a cylinder iteratively (GJK), and a pose
+    # read back from one world and set in the other can differ in its last bit (measured: 8 of 720 rays 34 um
+    # apart on a drum-shaped base; 1 of 720, tilted down onto the drum's rim, 104 um apart).
+    np.testing.assert_allclose(there[0] * (far - near), here[0] * (far - near), atol=2.5e-4)
     # Where two bodies meet (the walls' corners) a ray hits both at the same point, and which one Bullet
     # reports depends on the order of its broadphase tree: a tie, allowed where both hit at that distance.
     tie = (there[1] != here[1]) & (there[1] >= 0) & (here[1] >= 0)
