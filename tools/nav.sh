@@ -58,10 +58,13 @@ while IFS=$'\t' read -r name repo commit tarball sha; do
   dest="$WS/src/$name"
   want="${NAV_SOURCES:+tarball $tarball $sha}"
   want="${want:-git $commit}"
-  if [ -f "$dest/.diffbot_source" ] && [ "$(cat "$dest/.diffbot_source")" = "$want" ]; then
+  # The pinned commit, cloned or as its pinned tarball, is the same source: kept either way (a second run
+  # without network after a build from tarballs must not throw the sources away)
+  if [ -f "$dest/.diffbot_source" ] && { [ "$(cat "$dest/.diffbot_source")" = "git $commit" ] \
+       || [ "$(cat "$dest/.diffbot_source")" = "tarball $tarball $sha" ]; }; then
     continue
   fi
-  rm -rf "$dest" "$dest.tmp"
+  rm -rf "$dest.tmp"
   mkdir -p "$dest.tmp"
   if [ -n "${NAV_SOURCES:-}" ]; then
     file="$NAV_SOURCES/$tarball"
@@ -80,6 +83,7 @@ while IFS=$'\t' read -r name repo commit tarball sha; do
     rm -rf "$dest.tmp/.git"
   fi
   echo "$want" > "$dest.tmp/.diffbot_source"
+  rm -rf "$dest"  # only now: a failed fetch leaves the sources that were there
   mv "$dest.tmp" "$dest"
   rm -f "$WS/devel/.diffbot_built"
 done < "$PINNED"
