@@ -42,7 +42,7 @@ def wait_for_goal(client, timeout):
     return False
 
 
-class _JointStates:
+class JointStates:
     """The latest position and velocity of every joint on one joint_states topic (callbacks only store)."""
 
     def __init__(self, topic):
@@ -187,15 +187,20 @@ class _Sender:
         return ""
 
 
-def _settle(states, joints):
-    """Wait (sim time, at most SETTLE_TIMEOUT) until the moved joints held still, judged by the stamps of the
-    joint_states messages that came after the move (check.stillness.held_still)."""
-    since = rospy.get_time()
-    deadline = since + SETTLE_TIMEOUT
-    while rospy.get_time() < deadline and not rospy.is_shutdown():
-        if stillness.held_still(states.samples(joints, since), SETTLE_BAND, SETTLE_WINDOW)[0]:
-            return
+def settle(states, joints, band=SETTLE_BAND, window=SETTLE_WINDOW, timeout=SETTLE_TIMEOUT, since=None):
+    """Wait (sim time, at most ``timeout``) until ``joints`` held within ``band`` over ``window`` s, judged by the
+    stamps of the joint_states messages stamped at or after sim time ``since`` (default: now, i.e. after the move
+    just made; check.stillness.held_still). Returns (True, None), or (False, why) at the deadline."""
+    since = rospy.get_time() if since is None else since
+    deadline, why = rospy.get_time() + timeout, "shut down"
+    while not rospy.is_shutdown():
+        still, why = stillness.held_still(states.samples(joints, since), band, window)
+        if still:
+            return True, None
+        if rospy.get_time() >= deadline:
+            break
         rospy.sleep(0.05)
+    return False, why
 
 
 def check_arm(report, wait):
@@ -206,9 +211,9 @@ def check_arm(report, wait):
     ``wait(predicate, timeout, what)``: the caller's wait, which raises when the simulator dies.
     """
     ns = report.control_ns
-    states = _JointStates(_name(ns, "joint_states"))
+    states = JointStates(_name(ns, "joint_states"))
     wait(lambda: states.get()[2] > 0, SERVER_TIMEOUT, f"{_name(ns, 'joint_states')}")
-    _settle(states, [j.name for j in report.joints])  # the controllers have started and hold the joints
+    settle(states, [j.name for j in report.joints])  # the controllers have started and hold the joints
     positions = states.get()[0]
     moves, skipped = arm_report.plan_moves(report.joints, positions,
                                            arm_report.controller_joints(report.controllers, ns))
@@ -222,7 +227,7 @@ def check_arm(report, wait):
         start = [positions[j] for j in move.joints]
         for phase, targets in (("out", move.targets), ("back", start)):
             answer = sender.send(move, targets)
-            _settle(states, move.moved)
+            settle(states, move.moved)
             errors, reached = body.errors(states)
             results.append(arm_report.judge_move(move, phase, dict(zip(move.joints, targets)), reached, slides,
                                                  errors, answer))

@@ -14,11 +14,11 @@ import sys
 
 import rospy
 
-from diffbot_sim.check import stillness
 from diffbot_sim.check.arm_check import forward_kinematics
 from diffbot_sim.control import pick_place as pp
 from diffbot_sim.description.urdf_model import parse_urdf
 from diffbot_sim.errors import DiffbotSimError
+from diffbot_sim.nodes._arm_moves import JointStates, settle
 from diffbot_sim.values import check_number
 
 ARM_GROUP, GRIPPER_GROUP = "arm", "gripper"
@@ -80,7 +80,9 @@ class MoveItArm:
         error code."""
         from moveit_msgs.msg import MoveItErrorCodes
 
-        still, why = self.joints.wait_still(self.arm_joints, STILL_BAND, STILL_WINDOW, STILL_WAIT)
+        # the samples of the last second (JointStates keeps them): an arm already at rest is not waited for
+        still, why = settle(self.joints, self.arm_joints, STILL_BAND, STILL_WINDOW, STILL_WAIT,
+                            since=rospy.get_time() - 1.0)
         if not still:
             rospy.logwarn(f"pick_place: {what}: the arm did not come to rest within {STILL_WAIT} s ({why}); "
                           f"planning anyway")
@@ -143,56 +145,15 @@ def _code_name(value, codes):
     return str(value)
 
 
-class JointWatch:
-    """joint_states as this node needs them: the latest position of each joint, and the last second of samples
-    (stamped in sim time) for :meth:`wait_still`."""
-
-    KEEP = 1.0  # s of samples kept
-
-    def __init__(self):
-        import collections
-        import threading
-
-        from sensor_msgs.msg import JointState
-
-        self._latest = {}
-        self._samples = collections.deque()  # (stamp, {name: position})
-        self._lock = threading.Lock()
-        rospy.Subscriber("joint_states", JointState, self._keep, queue_size=5)
-
-    def _keep(self, msg):
-        stamp = msg.header.stamp.to_sec()
-        positions = dict(zip(msg.name, msg.position))
-        with self._lock:
-            self._latest.update(positions)
-            self._samples.append((stamp, positions))
-            while self._samples and self._samples[0][0] < stamp - self.KEEP:
-                self._samples.popleft()
-
-    def position(self, joint):
-        """``joint``'s latest position (waits up to 5 s of sim time for one)."""
-        deadline = rospy.get_time() + 5.0
-        while not rospy.is_shutdown() and rospy.get_time() < deadline:
-            with self._lock:
-                if joint in self._latest:
-                    return self._latest[joint]
-            rospy.sleep(0.02)
-        raise StepFailed(f"no {joint} on joint_states")
-
-    def wait_still(self, joints, band, window, timeout):
-        """(True, None) once ``joints`` have held within ``band`` over ``window`` s of message stamps
-        (:func:`diffbot_sim.check.stillness.held_still`), else (False, why) after ``timeout`` s of sim time."""
-        deadline, why = rospy.get_time() + timeout, "no joint_states"
-        while not rospy.is_shutdown():
-            with self._lock:
-                samples = [(t, [p[j] for j in joints]) for t, p in self._samples if all(j in p for j in joints)]
-            still, why = stillness.held_still(samples, band, window)
-            if still:
-                return True, None
-            if rospy.get_time() >= deadline:
-                return False, why
-            rospy.sleep(0.02)
-        return False, "shut down"
+def _latest(joints, name):
+    """``name``'s latest position on joint_states (waits up to 5 s of sim time for one)."""
+    deadline = rospy.get_time() + 5.0
+    while not rospy.is_shutdown() and rospy.get_time() < deadline:
+        positions = joints.get()[0]
+        if name in positions:
+            return positions[name]
+        rospy.sleep(0.02)
+    raise StepFailed(f"no {name} on joint_states")
 
 
 def run(Robot, BaseStepFailed, scene_from_params):
@@ -209,14 +170,14 @@ def run(Robot, BaseStepFailed, scene_from_params):
         origins = {link: pose[0] for link, pose in forward_kinematics(model, {}).items()}
         geometry = pp.arm_geometry(origins)
         robot = Robot(step_timeout)
-        joints = JointWatch()
+        joints = JointStates("joint_states")
         moveit = MoveItArm(scene, planning_time, attempts, joints)
         steps = pp.moveit_steps(scene, robot.current_pose())
     except (DiffbotSimError, KeyError, ValueError, BaseStepFailed, StepFailed, RuntimeError) as err:
         rospy.logfatal(f"pick_place: {err}")
         return 1
     rospy.loginfo("pick_place (MoveIt): the steps:\n" + "\n".join(pp.describe(steps)))
-    finger = functools.partial(joints.position, FINGER)
+    finger = functools.partial(_latest, joints, FINGER)
     moveit.add_tables()
     try:
         for index, step in enumerate(steps, 1):

@@ -125,7 +125,7 @@ class Simulator(LoopRequests):
         self._sensor_pubs = None  # the sensor plugins' publishers (NodeSync), rebuilt when robots change
         self._next_commander_scan = 0.0  # wall time of the next look at who publishes commands (NodeSync)
         self._rtf_mark = None  # (wall, sim, waited) at the last achieved-RTF report
-        self._paced_for_lag = False  # fast mode paced at real time for a lagging node (_lagging_node)
+        self._paced_for_lag = False  # fast mode paced at real time for a lagging node (set by _lagging_node)
 
     def publishers(self):
         """Every publisher the loop writes to (SubscriberLinks tunes and batches their connections)."""
@@ -262,7 +262,7 @@ class Simulator(LoopRequests):
                 self.wake.clear()
                 continue
             limit = MAX_BATCH_STEPS
-            if cfg.real_time or self._lagging_node():
+            if cfg.real_time or self._paced_for_lag:
                 dt = cfg.time_step
                 factor = cfg.real_time_factor if cfg.real_time else 1.0
                 limit, target = self._real_time_room(time.monotonic(), factor)
@@ -286,7 +286,8 @@ class Simulator(LoopRequests):
     def _lagging_node(self):
         """Fast mode with a node in the loop dropped for lagging and expected back (:meth:`NodeSync.lagging`): sim
         time is then paced at real time until it is taken back. Pacing is re-anchored when that begins (sim time
-        ran ahead of the wall clock until then)."""
+        ran ahead of the wall clock until then). Asked after each hold (``_wait_for_nodes``), where drops and
+        take-backs happen, not at every pass of the loop."""
         lagging = self.cfg.wait_for_nodes and self.sync.lagging()
         if lagging and not self._paced_for_lag:
             self._rebase()
@@ -385,6 +386,7 @@ class Simulator(LoopRequests):
             self.links.release()
             self.sync.forget_drops(fresh)
             self.sync.wait(fresh, self._serve_while_held, lambda: self.paused or rospy.is_shutdown())
+            self._lagging_node()
         self._report_rtf()
 
     def _command_subscribers(self):

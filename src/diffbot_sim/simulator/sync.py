@@ -317,7 +317,8 @@ class NodeSync:
     def lagging(self):
         """Whether a node dropped for outlasting the timeout is alive and expected back (it has drops left): while
         one is, the loop runs sim time no faster than real time, so that node falls no further behind than it would
-        at real time (gmapping, busy 5 s with its first scan, missed some 20 s of a fast tour and mapped it askew)."""
+        at real time (gmapping, busy 5 s with its first scan, was not waited for while a fast tour ran on, and mapped
+        it askew)."""
         return any(node.dropped and node.drops < MAX_DROPS and node.alive() for node in self.nodes.values())
 
     def take_back_idle(self, publishers, now_wall):
